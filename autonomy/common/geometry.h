@@ -1,0 +1,70 @@
+#pragma once
+// plane geometry value types shared by every module: vectors, poses, angles.
+#include <cmath>
+
+namespace paddock {
+
+inline constexpr double kPi = 3.14159265358979323846;
+inline constexpr double kGravity = 9.81;  // m/s^2
+
+struct Vec2 {
+  double x = 0.0;
+  double y = 0.0;
+
+  constexpr Vec2() = default;
+  constexpr Vec2(double x_, double y_) : x(x_), y(y_) {}
+  constexpr Vec2 operator+(Vec2 o) const { return {x + o.x, y + o.y}; }
+  constexpr Vec2 operator-(Vec2 o) const { return {x - o.x, y - o.y}; }
+  constexpr Vec2 operator-() const { return {-x, -y}; }
+  constexpr Vec2 operator*(double s) const { return {x * s, y * s}; }
+  constexpr Vec2 operator/(double s) const { return {x / s, y / s}; }
+  Vec2& operator+=(Vec2 o) { x += o.x; y += o.y; return *this; }
+  Vec2& operator-=(Vec2 o) { x -= o.x; y -= o.y; return *this; }
+  constexpr bool operator==(Vec2 o) const { return x == o.x && y == o.y; }
+};
+
+inline constexpr Vec2 operator*(double s, Vec2 v) { return {s * v.x, s * v.y}; }
+inline constexpr double dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
+// z component of the 3D cross product: > 0 when b is counter-clockwise of a
+inline constexpr double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
+inline double norm(Vec2 v) { return std::hypot(v.x, v.y); }
+inline constexpr double squared_norm(Vec2 v) { return v.x * v.x + v.y * v.y; }
+inline double distance(Vec2 a, Vec2 b) { return norm(a - b); }
+inline Vec2 unit_from_angle(double a) { return {std::cos(a), std::sin(a)}; }
+inline double angle_of(Vec2 v) { return std::atan2(v.y, v.x); }
+// counter-clockwise rotation by angle a
+inline Vec2 rotate(Vec2 v, double a) {
+  const double c = std::cos(a), s = std::sin(a);
+  return {c * v.x - s * v.y, s * v.x + c * v.y};
+}
+// left normal (v rotated by +90 degrees)
+inline constexpr Vec2 left_normal(Vec2 v) { return {-v.y, v.x}; }
+
+// angle wrapped into [-pi, pi)
+inline double wrap_angle(double a) {
+  a = std::fmod(a + kPi, 2.0 * kPi);
+  if (a < 0.0) a += 2.0 * kPi;
+  return a - kPi;
+}
+
+// a rigid 2D pose: position and yaw (counter-clockwise from +x)
+struct Pose2 {
+  double x = 0.0;
+  double y = 0.0;
+  double yaw = 0.0;
+
+  Vec2 position() const { return {x, y}; }
+  Vec2 heading() const { return unit_from_angle(yaw); }
+  // a point given in this pose's frame, expressed in the parent frame
+  Vec2 transform(Vec2 p) const { return position() + rotate(p, yaw); }
+  // a parent-frame point, expressed in this pose's frame
+  Vec2 inverse_transform(Vec2 p) const { return rotate(p - position(), -yaw); }
+};
+
+// a directed segment from a to b
+struct Segment {
+  Vec2 a;
+  Vec2 b;
+};
+
+}  // namespace paddock

@@ -1,0 +1,50 @@
+#pragma once
+// polylines and polygons: arc length, resampling, projection, containment, crossings.
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "autonomy/common/geometry.h"
+
+namespace paddock {
+
+// cumulative arc length at each vertex (s[0] = 0); a closed polyline gets one
+// more entry, the length including the closing segment back to vertex 0
+std::vector<double> cumulative_length(const std::vector<Vec2>& pts, bool closed);
+
+// total length, including the closing segment when closed
+double polyline_length(const std::vector<Vec2>& pts, bool closed);
+
+// points at equal arc-length spacing (as close to `spacing` as divides the
+// length evenly); an open polyline keeps both end points, a closed one
+// starts at vertex 0 and does not repeat it
+std::vector<Vec2> resample(const std::vector<Vec2>& pts, bool closed, double spacing);
+
+// the closest point of a polyline to a query point
+struct Projection {
+  Vec2 point;               // closest point on the polyline
+  std::size_t segment = 0;  // index i of the segment pts[i] -> pts[i+1] (wrapping when closed)
+  double t = 0.0;           // position along that segment in [0, 1]
+  double s = 0.0;           // arc length of the closest point
+  double distance = 0.0;    // distance from the query to `point`
+  double signed_offset = 0.0;  // > 0 when the query lies left of the polyline's direction
+};
+
+// brute force over all segments; pts must have at least two points
+Projection project(const std::vector<Vec2>& pts, bool closed, Vec2 q);
+
+// even-odd rule; the polygon is implicitly closed
+bool polygon_contains(const std::vector<Vec2>& polygon, Vec2 q);
+
+// signed area (> 0 counter-clockwise)
+double polygon_area(const std::vector<Vec2>& polygon);
+
+// where the directed motion p0 -> p1 crosses segment g from its right side to
+// its left side (left of the direction g.a -> g.b): the motion fraction in
+// [0, 1], or nothing; touching an end point counts
+std::optional<double> crossing_right_to_left(Vec2 p0, Vec2 p1, const Segment& g);
+
+// distance from q to the segment a-b
+double point_segment_distance(Vec2 q, Vec2 a, Vec2 b);
+
+}  // namespace paddock

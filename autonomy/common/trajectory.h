@@ -1,0 +1,47 @@
+#pragma once
+// the reference trajectory: what planning hands to control.
+#include <cstddef>
+#include <vector>
+
+#include "autonomy/common/geometry.h"
+
+namespace paddock {
+
+// one sample of a reference trajectory
+struct TrajectoryPoint {
+  double s = 0.0;          // arc length from the first point (m)
+  double x = 0.0;          // position in the map frame (m)
+  double y = 0.0;
+  double heading = 0.0;    // tangent direction (rad, counter-clockwise from +x)
+  double curvature = 0.0;  // signed, > 0 turning left (1/m)
+  double speed = 0.0;      // reference speed (m/s)
+
+  Vec2 position() const { return {x, y}; }
+};
+
+// samples at a fixed arc-length spacing; a closed trajectory's last point
+// connects back to the first, and `length` then includes that closing step
+struct Trajectory {
+  std::vector<TrajectoryPoint> points;
+  bool closed = false;
+  double length = 0.0;  // m
+
+  bool empty() const { return points.size() < 2; }
+  // s wrapped into [0, length) when closed, clamped into [0, length] when open
+  double wrap(double s) const;
+  // linear interpolation of every field at arc length s (heading on the circle)
+  TrajectoryPoint at(double s) const;
+};
+
+// the closest point of a trajectory to a query position
+struct TrajectoryProjection {
+  double s = 0.0;        // arc length of the closest point (m)
+  double offset = 0.0;   // signed distance of the query from the path, > 0 left of it (m)
+  TrajectoryPoint ref;   // the interpolated reference at s
+};
+
+// the closest point, searched within +-window metres of arc length around
+// s_hint (a window <= 0 searches everything); the trajectory must not be empty
+TrajectoryProjection project(const Trajectory& traj, Vec2 q, double s_hint, double window);
+
+}  // namespace paddock
