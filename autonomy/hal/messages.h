@@ -1,0 +1,45 @@
+#pragma once
+// what crosses the HAL: timestamped sensor messages in, actuator commands out.
+// The sim back end and the hardware back end produce exactly these.
+#include <variant>
+
+#include "autonomy/common/geometry.h"
+#include "autonomy/common/time.h"
+
+namespace paddock::hal {
+
+// the autonomous system state machine of the FS rules
+enum class AsState { Off, Ready, Driving, Finished, Emergency };
+
+// a full state estimate of the vehicle base frame (rear axle centre) in the
+// map frame, as an INS (GNSS + IMU) unit would give it; the `slam =
+// ground_truth` source
+struct StateEstimate {
+  TimeNs stamp = 0;
+  Pose2 pose;             // base frame in the map frame
+  double vx = 0.0;        // longitudinal velocity of the base origin, base frame (m/s)
+  double vy = 0.0;        // lateral velocity of the base origin, base frame (m/s)
+  double yaw_rate = 0.0;  // rad/s, > 0 counter-clockwise
+};
+
+// the remote emergency system: the "go" signal and the emergency stop
+struct ResSignal {
+  TimeNs stamp = 0;
+  bool go = false;
+  bool emergency = false;
+};
+
+using SensorMessage = std::variant<StateEstimate, ResSignal>;
+
+// the stack's command to the car's low-level controllers
+struct ActuatorCommand {
+  TimeNs stamp = 0;
+  double steering_angle = 0.0;  // road-wheel angle request (rad, > 0 left)
+  double throttle = 0.0;        // fraction of the maximum drive force [0, 1]
+  double brake = 1.0;           // fraction of the maximum brake force [0, 1]
+  AsState as_state = AsState::Off;
+};
+
+const char* to_string(AsState s);
+
+}  // namespace paddock::hal

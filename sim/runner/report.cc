@@ -1,0 +1,178 @@
+#include "sim/runner/report.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "sim/world/track.h"
+
+namespace paddock::runner {
+namespace {
+
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+// JSON has no NaN or infinity
+std::string json_number(double v) { return std::isfinite(v) ? fmt(v) : "null"; }
+
+}  // namespace
+
+std::string fmt(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+std::vector<std::string> check_expectations(const Expectations& e, const RunResult& r) {
+  std::vector<std::string> failed;
+  const auto& ev = r.event;
+  const int laps = static_cast<int>(ev.laps.size());
+  if (e.finished && *e.finished != ev.finished) {
+    failed.push_back(std::string("finished: expected ") + (*e.finished ? "true" : "false") + ", got " +
+                     (ev.finished ? "true" : "false (" + ev.dnf_reason + ")"));
+  }
+  if (e.laps && laps != *e.laps) failed.push_back("laps: expected " + std::to_string(*e.laps) + ", got " + std::to_string(laps));
+  if (e.doo_max && ev.doo > *e.doo_max) failed.push_back("doo: expected at most " + std::to_string(*e.doo_max) + ", got " + std::to_string(ev.doo));
+  if (e.oc_max && ev.oc > *e.oc_max) failed.push_back("oc: expected at most " + std::to_string(*e.oc_max) + ", got " + std::to_string(ev.oc));
+  if (e.uss_max && ev.uss > *e.uss_max) failed.push_back("uss: expected at most " + std::to_string(*e.uss_max) + ", got " + std::to_string(ev.uss));
+  for (const auto& lap : ev.laps) {
+    if (e.lap_time_max && lap.time > *e.lap_time_max) {
+      failed.push_back("lap " + std::to_string(lap.number) + " time: expected at most " + fixed(*e.lap_time_max, 3) + " s, got " + fixed(lap.time, 3) + " s");
+    }
+    if (e.lap_time_min && lap.time < *e.lap_time_min) {
+      failed.push_back("lap " + std::to_string(lap.number) + " time: expected at least " + fixed(*e.lap_time_min, 3) + " s, got " + fixed(lap.time, 3) + " s");
+    }
+  }
+  if (e.total_time_max && ev.total_time > *e.total_time_max) {
+    failed.push_back("total time: expected at most " + fixed(*e.total_time_max, 3) + " s, got " + fixed(ev.total_time, 3) + " s");
+  }
+  if (e.lateral_rms_max && r.tracking.rms > *e.lateral_rms_max) {
+    failed.push_back("lateral rms: expected at most " + fixed(*e.lateral_rms_max, 3) + " m, got " + fixed(r.tracking.rms, 3) + " m");
+  }
+  if (e.lateral_error_max && r.tracking.max > *e.lateral_error_max) {
+    failed.push_back("lateral max: expected at most " + fixed(*e.lateral_error_max, 3) + " m, got " + fixed(r.tracking.max, 3) + " m");
+  }
+  if (e.fallbacks_max && r.fallbacks > *e.fallbacks_max) {
+    failed.push_back("fallbacks: expected at most " + std::to_string(*e.fallbacks_max) + ", got " + std::to_string(r.fallbacks));
+  }
+  return failed;
+}
+
+std::string summary_text(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed) {
+  std::ostringstream o;
+  const auto& ev = r.event;
+  const events::Rules rules = events::rules_for(s.scenario.event);
+  o << s.name << ": " << events::to_string(s.scenario.event) << " on " << s.track_path << "\n";
+  o << "  result      " << (ev.finished ? "finished" : "DNF: " + ev.dnf_reason) << "\n";
+  o << "  lap     time [s]   DOO  OC   rms [m]  max [m]  ITAE\n";
+  for (std::size_t i = 0; i < ev.laps.size(); ++i) {
+    const auto& lap = ev.laps[i];
+    const auto& tr = r.lap_tracking[i];
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "  %3d%s %9.3f   %3d %3d   %7.3f  %7.3f  %7.1f\n", lap.number, lap.timed ? " " : "*",
+                  lap.time, lap.doo, lap.oc, tr.rms, tr.max, tr.itae);
+    o << buf;
+  }
+  if (!rules.timed_laps.empty()) o << "  (* untimed lap)\n";
+  o << "  penalties   DOO " << ev.doo << " x " << fixed(rules.doo_penalty, 1) << " s, OC " << ev.oc << " x "
+    << fixed(rules.oc_penalty, 1) << " s, USS " << ev.uss << " x " << fixed(rules.uss_penalty, 1) << " s\n";
+  for (const ConeHit& c : r.cones_hit) {
+    o << "  cone down   " << cone_tag(c.color) << " at (" << fixed(c.position.x, 2) << ", " << fixed(c.position.y, 2)
+      << ") " << (c.knocked ? "knocked over" : "pushed out of place") << " at t = " << fixed(c.t, 2) << " s\n";
+  }
+  o << "  time        raw " << fixed(ev.raw_time, 3) << " s" << (rules.score_mean ? " (mean of timed laps)" : "")
+    << ", total " << fixed(ev.total_time, 3) << " s\n";
+  o << "  tracking    rms " << fixed(r.tracking.rms, 3) << " m, max " << fixed(r.tracking.max, 3) << " m, ITAE "
+    << fixed(r.tracking.itae, 1) << " (mean per lap)\n";
+  o << "  stack       " << r.fallbacks << " fallback cycles" << (r.fault.empty() ? "" : ", last fault: " + r.fault) << "\n";
+  o << "  speed       " << fixed(r.sim_time, 1) << " s simulated in " << fixed(r.wall_time, 3) << " s ("
+    << fixed(r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0, 0) << "x real time)\n";
+  if (!failed.empty()) {
+    o << "  EXPECTATIONS FAILED:\n";
+    for (const auto& f : failed) o << "    " << f << "\n";
+  }
+  return o.str();
+}
+
+std::string summary_json(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed) {
+  std::ostringstream o;
+  const auto& ev = r.event;
+  const events::Rules rules = events::rules_for(s.scenario.event);
+  o << "{\"scenario\":" << json_string(s.name) << ",\"track\":" << json_string(s.track_path)
+    << ",\"event\":" << json_string(events::to_string(s.scenario.event)) << ",\"seed\":" << s.scenario.seed
+    << ",\"finished\":" << (ev.finished ? "true" : "false") << ",\"dnf_reason\":" << json_string(ev.dnf_reason)
+    << ",\"laps\":[";
+  for (std::size_t i = 0; i < ev.laps.size(); ++i) {
+    const auto& lap = ev.laps[i];
+    const auto& tr = r.lap_tracking[i];
+    o << (i ? "," : "") << "{\"lap\":" << lap.number << ",\"time\":" << json_number(lap.time)
+      << ",\"timed\":" << (lap.timed ? "true" : "false") << ",\"doo\":" << lap.doo << ",\"oc\":" << lap.oc
+      << ",\"tracking\":{\"rms\":" << json_number(tr.rms) << ",\"max\":" << json_number(tr.max)
+      << ",\"itae\":" << json_number(tr.itae) << "}}";
+  }
+  const double penalty_s = rules.doo_penalty * ev.doo + rules.oc_penalty * ev.oc + rules.uss_penalty * ev.uss;
+  o << "],\"penalties\":{\"doo\":" << ev.doo << ",\"oc\":" << ev.oc << ",\"uss\":" << ev.uss
+    << ",\"seconds\":" << json_number(penalty_s) << ",\"cones\":[";
+  for (std::size_t i = 0; i < r.cones_hit.size(); ++i) {
+    const ConeHit& c = r.cones_hit[i];
+    o << (i ? "," : "") << "{\"x\":" << json_number(c.position.x) << ",\"y\":" << json_number(c.position.y)
+      << ",\"color\":" << json_string(std::string(cone_tag(c.color))) << ",\"t\":" << json_number(c.t)
+      << ",\"cause\":" << json_string(c.knocked ? "knocked" : "displaced") << "}";
+  }
+  o << "]}"
+    << ",\"raw_time\":" << json_number(ev.raw_time) << ",\"total_time\":" << json_number(ev.total_time)
+    << ",\"sim_time\":" << json_number(r.sim_time) << ",\"wall_time\":" << json_number(r.wall_time)
+    << ",\"realtime_factor\":" << json_number(r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0)
+    << ",\"tracking\":{\"rms\":" << json_number(r.tracking.rms) << ",\"max\":" << json_number(r.tracking.max)
+    << ",\"itae\":" << json_number(r.tracking.itae) << "}"
+    << ",\"stack\":{\"fallbacks\":" << r.fallbacks << ",\"fault\":" << json_string(r.fault) << "}"
+    << ",\"expectations_failed\":[";
+  for (std::size_t i = 0; i < failed.size(); ++i) o << (i ? "," : "") << json_string(failed[i]);
+  o << "]}\n";
+  return o.str();
+}
+
+std::string log_csv(const std::vector<LogRow>& log) {
+  std::string out =
+      "t,x,y,yaw,vx,vy,yaw_rate,steer_cmd,steer,throttle,brake,v_ref,lateral_error,heading_error,s,lap,as_state\n";
+  out.reserve(out.size() + log.size() * 200);
+  for (const LogRow& r : log) {
+    for (double v : {r.t, r.x, r.y, r.yaw, r.vx, r.vy, r.yaw_rate, r.steer_cmd, r.steer, r.throttle, r.brake, r.v_ref,
+                     r.lateral_error, r.heading_error, r.s}) {
+      out += fmt(v);
+      out += ',';
+    }
+    out += std::to_string(r.lap);
+    out += ',';
+    out += std::to_string(r.as_state);
+    out += '\n';
+  }
+  return out;
+}
+
+}  // namespace paddock::runner

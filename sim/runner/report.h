@@ -1,0 +1,27 @@
+#pragma once
+// what a run leaves behind: the readable summary, summary.json, log.csv, and
+// the check of a scenario's [expect] section.
+#include <string>
+#include <vector>
+
+#include "sim/runner/scenario.h"
+#include "sim/runner/simulation.h"
+
+namespace paddock::runner {
+
+// each [expect] entry that does not hold, as "what: expected ..., got ..."
+std::vector<std::string> check_expectations(const Expectations& e, const RunResult& r);
+
+// the readable summary printed by `paddock run`
+std::string summary_text(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed);
+
+// one JSON object (schema in the README)
+std::string summary_json(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed);
+
+// the log rows as CSV with a header line
+std::string log_csv(const std::vector<LogRow>& log);
+
+// a double as the shortest text that reads back to the same value
+std::string fmt(double v);
+
+}  // namespace paddock::runner

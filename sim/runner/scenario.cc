@@ -1,0 +1,434 @@
+#include "sim/runner/scenario.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "sim/runner/files.h"
+#include "sim/runner/ini.h"
+#include "sim/runner/report.h"
+#include "sim/runner/schema.h"
+
+namespace paddock::runner {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+std::string trim(const std::string& s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string::npos) return "";
+  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
+}
+
+// other units accepted for a stored SI unit, with their factor to it
+const std::map<std::string, std::map<std::string, double>>& conversions() {
+  static const std::map<std::string, std::map<std::string, double>> table = {
+      {"rad", {{"deg", kPi / 180.0}}},
+      {"rad/s", {{"deg/s", kPi / 180.0}}},
+      {"m/s", {{"km/h", 1.0 / 3.6}}},
+      {"s", {{"ms", 1e-3}}},
+      {"m", {{"cm", 1e-2}, {"mm", 1e-3}}},
+      {"m/s^2", {{"g", kGravity}}},
+  };
+  return table;
+}
+
+std::string range_text(double lo, double hi, const std::string& unit) {
+  std::string u = unit.empty() ? "" : " " + unit;
+  if (std::isinf(hi)) return "at least " + fmt(lo) + u;
+  return "between " + fmt(lo) + " and " + fmt(hi) + u;
+}
+
+// ---- field builders: each binds one key to one member through an accessor ----
+
+template <class Acc>
+Field real_field(const char* sec, const char* key, const char* unit, double lo, double hi, const char* doc, Acc acc,
+                 bool required = false) {
+  Field f{sec, key, unit, doc, required, {}, {}};
+  const std::string u = unit;
+  f.set = [=](Scenario& s, const IniEntry& e) { acc(s) = parse_quantity(e, u, lo, hi); };
+  f.get = [=](const Scenario& s) { return fmt(acc(s)); };
+  return f;
+}
+
+template <class Acc>
+Field int_field(const char* sec, const char* key, const char* unit, long lo, long hi, const char* doc, Acc acc) {
+  Field f{sec, key, unit, doc, false, {}, {}};
+  f.set = [=](Scenario& s, const IniEntry& e) {
+    acc(s) = static_cast<std::remove_reference_t<decltype(acc(s))>>(parse_integer(e, lo, hi));
+  };
+  f.get = [=](const Scenario& s) { return std::to_string(acc(s)); };
+  return f;
+}
+
+template <class Acc>
+Field bool_field(const char* sec, const char* key, const char* doc, Acc acc) {
+  Field f{sec, key, "", doc, false, {}, {}};
+  f.set = [=](Scenario& s, const IniEntry& e) { acc(s) = parse_bool(e); };
+  f.get = [=](const Scenario& s) { return std::string(acc(s) ? "true" : "false"); };
+  return f;
+}
+
+template <class E, class Acc>
+Field enum_field(const char* sec, const char* key, const char* doc, std::vector<std::pair<std::string, E>> names,
+                 Acc acc) {
+  Field f{sec, key, "", doc, false, {}, {}};
+  f.set = [=](Scenario& s, const IniEntry& e) {
+    std::string options;
+    for (const auto& [n, v] : names) {
+      if (n == e.value) {
+        acc(s) = v;
+        return;
+      }
+      options += (options.empty() ? "" : ", ") + n;
+    }
+    throw UserError(e.where() + ": [" + e.section + "] " + e.key + " = '" + e.value + "' is not known; expected one of: " + options);
+  };
+  f.get = [=](const Scenario& s) {
+    for (const auto& [n, v] : names)
+      if (v == acc(s)) return n;
+    return std::string("?");
+  };
+  return f;
+}
+
+// an optional [expect] value
+template <class T, class Acc>
+Field expect_field(const char* key, const char* unit, const char* doc, Acc acc) {
+  Field f{"expect", key, unit, doc, false, {}, {}};
+  const std::string u = unit;
+  f.set = [=](Scenario& s, const IniEntry& e) {
+    if constexpr (std::is_same_v<T, bool>) acc(s) = parse_bool(e);
+    else if constexpr (std::is_same_v<T, int>) acc(s) = static_cast<int>(parse_integer(e, 0, 1000000));
+    else acc(s) = parse_quantity(e, u, 0.0, kInf);
+  };
+  f.get = [=](const Scenario& s) -> std::string {
+    const auto& v = acc(s);
+    if (!v) return "";
+    if constexpr (std::is_same_v<T, bool>) return *v ? "true" : "false";
+    else if constexpr (std::is_same_v<T, int>) return std::to_string(*v);
+    else return fmt(*v);
+  };
+  return f;
+}
+
+// [vehicle]: every key required (the values come from a vehicle file such as
+// scenarios/vehicles/default.ini, the one place they are written); the vehicle
+// module lists its fields and validates them as a whole after loading
+void add_vehicle_fields(std::vector<Field>& f) {
+  for (const vehicle::ParamField& p : vehicle::param_fields()) {
+    const auto m = p.member;
+    f.push_back(real_field("vehicle", p.name, p.unit, -kInf, kInf, "",
+                           [m](auto& s) -> auto& { return s.vehicle.*m; }, true));
+  }
+}
+
+#define ACC(member) [](auto& s) -> auto& { return s.member; }
+
+// [cones]: the Box2D cone world's physics
+void add_cone_fields(std::vector<Field>& f) {
+  f.push_back(real_field("cones", "small_mass", "kg", 0.01, 100.0, "small cone mass", ACC(cones.small_cone.mass)));
+  f.push_back(real_field("cones", "small_knock_impulse", "N s", 0.0, 1000.0, "impulse that knocks a small cone over",
+                         ACC(cones.small_cone.knock_impulse)));
+  f.push_back(real_field("cones", "big_mass", "kg", 0.01, 100.0, "big orange cone mass", ACC(cones.big_cone.mass)));
+  f.push_back(real_field("cones", "big_knock_impulse", "N s", 0.0, 1000.0, "impulse that knocks a big cone over",
+                         ACC(cones.big_cone.knock_impulse)));
+  f.push_back(real_field("cones", "ground_friction", "", 0.0, 5.0, "cone-on-asphalt friction coefficient", ACC(cones.ground_friction)));
+  f.push_back(real_field("cones", "car_friction", "", 0.0, 5.0, "car-cone friction coefficient", ACC(cones.car_cone_friction)));
+  f.push_back(real_field("cones", "car_restitution", "", 0.0, 1.0, "car-cone restitution", ACC(cones.car_cone_restitution)));
+}
+
+std::vector<Field> build_fields() {
+  using events::EventKind;
+  std::vector<Field> f;
+  // [scenario]
+  {
+    Field track{"scenario", "track", "", "track CSV file, relative to the file that names it", true, {}, {}};
+    track.set = [](Scenario& s, const IniEntry& e) {
+      if (e.value.empty()) throw UserError(e.where() + ": [scenario] track needs a file name");
+      namespace fs = std::filesystem;
+      const fs::path p(e.value);
+      const fs::path base = e.file == "--set" ? fs::path() : fs::path(e.file).parent_path();
+      s.scenario.track = e.value;
+      s.track_path = (p.is_absolute() ? p : (base / p)).lexically_normal().string();
+    };
+    track.get = [](const Scenario& s) { return std::filesystem::absolute(s.track_path).lexically_normal().string(); };
+    f.push_back(track);
+  }
+  f.push_back(enum_field<EventKind>("scenario", "event", "the FS event and its rules",
+                                    {{"trackdrive", EventKind::Trackdrive}, {"autocross", EventKind::Autocross},
+                                     {"acceleration", EventKind::Acceleration}, {"skidpad", EventKind::Skidpad}},
+                                    ACC(scenario.event)));
+  {
+    Field seed{"scenario", "seed", "", "the run's random seed (every random draw derives from it)", false, {}, {}};
+    seed.set = [](Scenario& s, const IniEntry& e) {
+      s.scenario.seed = static_cast<std::uint64_t>(parse_integer(e, 0, std::numeric_limits<long>::max()));
+    };
+    seed.get = [](const Scenario& s) { return std::to_string(s.scenario.seed); };
+    f.push_back(seed);
+  }
+  f.push_back(real_field("scenario", "go_time", "s", 0.0, 600.0, "time in AS Ready before the go signal", ACC(scenario.go_time)));
+
+  // [autonomy]
+  using namespace stack;
+  f.push_back(enum_field<PerceptionMode>("autonomy", "perception", "where the cones come from",
+                                         {{"ground_truth", PerceptionMode::GroundTruth}}, ACC(autonomy.perception)));
+  f.push_back(enum_field<SlamMode>("autonomy", "slam", "where the pose comes from", {{"ground_truth", SlamMode::GroundTruth}},
+                                   ACC(autonomy.slam)));
+  f.push_back(enum_field<PlannerMode>("autonomy", "planner", "where the reference path comes from",
+                                      {{"oracle", PlannerMode::Oracle}}, ACC(autonomy.planner)));
+
+  // [control]
+  using control::LateralMode;
+  f.push_back(enum_field<LateralMode>("control", "lateral", "lateral control law",
+                                      {{"combined", LateralMode::Combined}, {"stanley", LateralMode::Stanley},
+                                       {"pure_pursuit", LateralMode::PurePursuit}},
+                                      ACC(control.lateral)));
+  f.push_back(real_field("control", "stanley_k", "1/s", 0.0, 100.0, "Stanley cross-track gain", ACC(control.stanley.k)));
+  f.push_back(real_field("control", "stanley_k_soft", "m/s", 0.0, 100.0, "Stanley softening speed", ACC(control.stanley.k_soft)));
+  f.push_back(bool_field("control", "stanley_steady_state_yaw", "add Hoffmann's steady-state yaw to Stanley",
+                         ACC(control.stanley.use_steady_state_yaw)));
+  f.push_back(real_field("control", "pp_lookahead_min", "m", 0.1, 100.0, "pure pursuit look-ahead at standstill L_min",
+                         ACC(control.pure_pursuit.L_min)));
+  f.push_back(real_field("control", "pp_lookahead_gain", "s", 0.0, 10.0, "pure pursuit look-ahead growth k_v",
+                         ACC(control.pure_pursuit.k_v)));
+  f.push_back(real_field("control", "k_min", "", 0.0, 1.0, "combined: pure pursuit weight on a straight", ACC(control.combined.k_min)));
+  f.push_back(real_field("control", "k_max", "", 0.0, 1.0, "combined: largest pure pursuit weight", ACC(control.combined.k_max)));
+  f.push_back(real_field("control", "kappa_ref", "1/m", 1e-6, 100.0, "combined: curvature scale", ACC(control.combined.kappa_ref)));
+  f.push_back(real_field("control", "k_curve", "", 0.0, 10.0, "combined: weight added per kappa_ref", ACC(control.combined.k_curve)));
+  f.push_back(real_field("control", "k_d_yaw", "s", 0.0, 10.0, "yaw-rate damping gain", ACC(control.k_d_yaw)));
+  f.push_back(real_field("control", "speed_kp", "1/s", 0.0, 100.0, "speed loop proportional gain", ACC(control.longitudinal.kp)));
+  f.push_back(real_field("control", "speed_ki", "1/s^2", 0.0, 100.0, "speed loop integral gain", ACC(control.longitudinal.ki)));
+  f.push_back(real_field("control", "speed_integral_limit", "m/s^2", 0.0, 100.0, "bound of the integral term",
+                         ACC(control.longitudinal.integral_limit)));
+  f.push_back(real_field("control", "speed_feedforward", "", 0.0, 2.0, "scale of the model feedforward",
+                         ACC(control.longitudinal.feedforward_gain)));
+  f.push_back(real_field("control", "speed_preview", "s", 0.0, 5.0, "the reference speed is read this far ahead",
+                         ACC(control.longitudinal.speed_preview_time)));
+  f.push_back(real_field("control", "projection_window", "m", 0.1, 100.0, "arc-length window of the path projection",
+                         ACC(control.projection_window)));
+
+  // [planning]
+  f.push_back(real_field("planning", "knot_spacing", "m", 0.1, 50.0, "spline knot spacing along the centreline",
+                         ACC(planning.knot_spacing)));
+  f.push_back(real_field("planning", "ds", "m", 0.01, 10.0, "trajectory sample spacing", ACC(planning.ds)));
+  f.push_back(real_field("planning", "ax_max", "m/s^2", 0.1, 100.0, "tyre acceleration limit of the profile", ACC(planning.profile.ax_max)));
+  f.push_back(real_field("planning", "ay_max", "m/s^2", 0.1, 100.0, "tyre lateral limit of the profile", ACC(planning.profile.ay_max)));
+  f.push_back(real_field("planning", "ax_brake_max", "m/s^2", 0.1, 100.0, "tyre deceleration limit of the profile",
+                         ACC(planning.profile.ax_brake_max)));
+  f.push_back(real_field("planning", "exponent", "", 1.0, 10.0, "g-g diagram exponent p", ACC(planning.profile.exponent)));
+  f.push_back(real_field("planning", "ax_machine", "m/s^2", 0.1, 100.0, "motor acceleration limit", ACC(planning.profile.ax_machine)));
+  f.push_back(real_field("planning", "v_max", "m/s", 0.1, 100.0, "top speed of the profile", ACC(planning.profile.v_max)));
+  f.push_back(real_field("planning", "turn_accel_scale", "", 0.0, 1.0, "longitudinal limits kept in a full-grip turn",
+                         ACC(planning.profile.turn_accel_scale)));
+
+  // [mission]
+  f.push_back(real_field("mission", "stop_decel", "m/s^2", 0.1, 50.0, "deceleration of the stop after the finish", ACC(mission.stop_decel)));
+  f.push_back(real_field("mission", "standstill_speed", "m/s", 0.0, 5.0, "below this the stack counts as stopped",
+                         ACC(mission.standstill_speed)));
+  f.push_back(real_field("mission", "state_timeout", "s", 0.001, 10.0, "a staler state estimate triggers the safe stop",
+                         ACC(mission.state_timeout)));
+
+  // [event]
+  f.push_back(real_field("event", "timeout", "s", 1.0, 86400.0, "sim time after the go before a DNF", ACC(event.timeout)));
+  f.push_back(real_field("event", "stop_time", "s", 1.0, 600.0, "time after the finish to come to rest", ACC(event.stop_time)));
+  f.push_back(real_field("event", "off_track_dnf_time", "s", 0.01, 600.0, "time with all wheels off that ends the run",
+                         ACC(event.off_track_dnf_time)));
+  f.push_back(real_field("event", "stall_time", "s", 0.1, 600.0, "time at rest before the finish that ends the run", ACC(event.stall_time)));
+  f.push_back(real_field("event", "standstill_speed", "m/s", 0.0, 5.0, "slower counts as at rest", ACC(event.standstill_speed)));
+
+  // [sim]
+  f.push_back(int_field("sim", "physics_rate", "Hz", 1, 100000, "vehicle and world integration rate", ACC(sim.physics_rate)));
+  f.push_back(int_field("sim", "control_rate", "Hz", 1, 100000, "stack cycle rate", ACC(sim.control_rate)));
+  f.push_back(int_field("sim", "log_rate", "Hz", 1, 100000, "log.csv rows and off-course checks", ACC(sim.log_rate)));
+
+  // [vehicle] and [cones]: see add_vehicle_fields and add_cone_fields
+  add_vehicle_fields(f);
+  add_cone_fields(f);
+
+  // [expect]
+  f.push_back(expect_field<bool>("finished", "", "the run finishes", ACC(expect.finished)));
+  f.push_back(expect_field<int>("laps", "", "completed laps", ACC(expect.laps)));
+  f.push_back(expect_field<int>("doo_max", "", "cones down or out, at most", ACC(expect.doo_max)));
+  f.push_back(expect_field<int>("oc_max", "", "off-course excursions, at most", ACC(expect.oc_max)));
+  f.push_back(expect_field<int>("uss_max", "", "unsafe stops, at most", ACC(expect.uss_max)));
+  f.push_back(expect_field<double>("lap_time_max", "s", "every lap at most", ACC(expect.lap_time_max)));
+  f.push_back(expect_field<double>("lap_time_min", "s", "every lap at least", ACC(expect.lap_time_min)));
+  f.push_back(expect_field<double>("total_time_max", "s", "penalised time at most", ACC(expect.total_time_max)));
+  f.push_back(expect_field<double>("lateral_rms_max", "m", "RMS lateral error at most", ACC(expect.lateral_rms_max)));
+  f.push_back(expect_field<double>("lateral_error_max", "m", "largest lateral error at most", ACC(expect.lateral_error_max)));
+  f.push_back(expect_field<int>("fallbacks_max", "", "safe-stop control cycles, at most", ACC(expect.fallbacks_max)));
+  return f;
+}
+
+}  // namespace
+
+double parse_quantity(const IniEntry& e, const std::string& unit, double lo, double hi) {
+  const std::string& v = e.value;
+  const char* begin = v.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const double x = std::strtod(begin, &end);
+  const std::string what = "[" + e.section + "] " + e.key;
+  const std::string expected = "expected a number" + (unit.empty() ? std::string() : " in " + unit);
+  if (end == begin || errno == ERANGE || !std::isfinite(x)) {
+    throw UserError(e.where() + ": " + what + " = '" + v + "' is not a number; " + expected);
+  }
+  const std::string suffix = trim(std::string(end));
+  double factor = 1.0;
+  if (!suffix.empty() && suffix != unit) {
+    const auto table = conversions().find(unit);
+    const auto conv = table == conversions().end() ? nullptr : &table->second;
+    if (!conv || conv->find(suffix) == conv->end()) {
+      throw UserError(e.where() + ": " + what + " = '" + v + "': unit '" + suffix + "' does not fit; " + expected);
+    }
+    factor = conv->at(suffix);
+  }
+  const double value = x * factor;
+  if (value < lo || value > hi) {
+    throw UserError(e.where() + ": " + what + " = " + v + " is out of range; expected " + range_text(lo, hi, unit));
+  }
+  return value;
+}
+
+long parse_integer(const IniEntry& e, long lo, long hi) {
+  const char* begin = e.value.c_str();
+  char* end = nullptr;
+  errno = 0;
+  const long x = std::strtol(begin, &end, 10);
+  const std::string what = "[" + e.section + "] " + e.key;
+  if (end == begin || *end != '\0' || errno == ERANGE) {
+    throw UserError(e.where() + ": " + what + " = '" + e.value + "' is not an integer; expected a whole number");
+  }
+  if (x < lo || x > hi) {
+    throw UserError(e.where() + ": " + what + " = " + e.value + " is out of range; expected between " + std::to_string(lo) +
+                    " and " + std::to_string(hi));
+  }
+  return x;
+}
+
+bool parse_bool(const IniEntry& e) {
+  if (e.value == "true" || e.value == "yes" || e.value == "on" || e.value == "1") return true;
+  if (e.value == "false" || e.value == "no" || e.value == "off" || e.value == "0") return false;
+  throw UserError(e.where() + ": [" + e.section + "] " + e.key + " = '" + e.value + "' is not a boolean; expected true or false");
+}
+
+const std::vector<Field>& scenario_fields() {
+  static const std::vector<Field> fields = build_fields();
+  return fields;
+}
+
+Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides) {
+  std::vector<IniEntry> entries = read_ini_file(path);
+  // command-line overrides come last, so they win
+  for (std::size_t i = 0; i < overrides.size(); ++i) {
+    const std::string& o = overrides[i];
+    const auto dot = o.find('.');
+    const auto eq = o.find('=');
+    if (dot == std::string::npos || eq == std::string::npos || dot > eq) {
+      throw UserError("--set " + o + ": expected section.key=value");
+    }
+    entries.push_back({trim(o.substr(0, dot)), trim(o.substr(dot + 1, eq - dot - 1)), trim(o.substr(eq + 1)), "--set",
+                       static_cast<int>(i + 1)});
+  }
+
+  // every entry must name a known key; later entries override earlier ones
+  const auto& fields = scenario_fields();
+  std::map<std::pair<std::string, std::string>, const Field*> index;
+  std::set<std::string> sections;
+  for (const auto& f : fields) {
+    index[{f.section, f.key}] = &f;
+    sections.insert(f.section);
+  }
+  Scenario s;
+  std::set<std::pair<std::string, std::string>> given;
+  for (const auto& e : entries) {
+    if (!sections.count(e.section)) {
+      std::string known;
+      for (const auto& n : sections) known += (known.empty() ? "" : ", ") + ("[" + n + "]");
+      throw UserError(e.where() + ": unknown section [" + e.section + "]; expected one of: " + known);
+    }
+    const auto it = index.find({e.section, e.key});
+    if (it == index.end()) {
+      std::string known;
+      for (const auto& f : fields)
+        if (f.section == e.section) known += (known.empty() ? "" : ", ") + f.key;
+      throw UserError(e.where() + ": unknown key '" + e.key + "' in [" + e.section + "]; expected one of: " + known);
+    }
+    it->second->set(s, e);
+    given.insert({e.section, e.key});
+  }
+  for (const auto& f : fields) {
+    if (f.required && !given.count({f.section, f.key})) {
+      throw UserError(path + ": [" + f.section + "] " + f.key + " is not set" +
+                      (f.unit.empty() ? "" : " (" + f.unit + ")") +
+                      (f.section == "vehicle" ? "; include a vehicle file, e.g. include = vehicles/default.ini" : ""));
+    }
+  }
+
+  // whole-scenario checks
+  if (const std::string why = vehicle::validate(s.vehicle); !why.empty()) throw UserError(path + ": [vehicle] " + why);
+  if (s.sim.physics_rate % s.sim.control_rate != 0 || s.sim.physics_rate % s.sim.log_rate != 0) {
+    throw UserError(path + ": [sim] physics_rate (" + std::to_string(s.sim.physics_rate) +
+                    " Hz) must be a whole multiple of control_rate and log_rate");
+  }
+  if (const char* why = control::validate(s.control, stack_params(s).vehicle)) throw UserError(path + ": [control] " + why);
+
+  s.source = path;
+  s.name = std::filesystem::path(path).stem().string();
+  return s;
+}
+
+std::string resolved_ini(const Scenario& s) {
+  std::ostringstream o;
+  o << "; the resolved scenario of a run: every key, defaults included, in SI units\n";
+  o << "; from " << s.source << "\n";
+  std::string section;
+  for (const auto& f : scenario_fields()) {
+    if (f.section != section) {
+      section = f.section;
+      o << "\n[" << section << "]\n";
+    }
+    const std::string v = f.get(s);
+    std::string comment = f.unit.empty() ? f.doc : f.doc.empty() ? f.unit : f.unit + ", " + f.doc;
+    if (v.empty()) o << "; " << f.key << " =  ; (not checked) " << comment << "\n";
+    else o << f.key << " = " << v << "  ; " << comment << "\n";
+  }
+  return o.str();
+}
+
+}  // namespace paddock::runner
+
+namespace paddock::runner {
+
+stack::StackParams stack_params(const Scenario& s) {
+  stack::StackParams p;
+  p.modes = s.autonomy;
+  p.control = s.control;
+  p.mission = s.mission;
+  // what the stack knows of its car comes from the same [vehicle] section as
+  // the simulated car: one place for each value
+  const vehicle::VehicleParams& v = s.vehicle;
+  control::VehicleKnowledge& k = p.vehicle;
+  k.mass = v.mass;
+  k.lf = v.lf;
+  k.lr = v.lr;
+  k.wheelbase = v.lf + v.lr;
+  k.front_cornering_stiffness = control::front_axle_cornering_stiffness(v.tyre_b, v.tyre_c, v.tyre_d, v.mass, v.lf, v.lr);
+  k.max_steering_angle = v.steering_max;
+  k.max_drive_force = v.cm1;
+  k.max_brake_force = v.brake_force_max;
+  k.drag_coefficient = v.c_drag;
+  k.rolling_resistance = v.cr0;
+  p.reference = s.planning;
+  p.reference.profile.mass = v.mass;
+  p.reference.profile.drag_coefficient = v.c_drag;
+  return p;
+}
+
+}  // namespace paddock::runner

@@ -1,0 +1,229 @@
+#include "sim/runner/simulation.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "sim/runner/sim_hal.h"
+#include "sim/vehicle/vehicle.h"
+#include "sim/world/cone_world.h"
+
+namespace paddock::runner {
+namespace {
+
+// points every `step` metres along an arc of a circle around c, from angle a0
+// turning by `sweep` (> 0 counter-clockwise), the start point excluded
+void append_arc(std::vector<Vec2>& out, Vec2 c, double r, double a0, double sweep, double step) {
+  const int n = std::max(1, static_cast<int>(std::ceil(std::abs(sweep) * r / step)));
+  for (int i = 1; i <= n; ++i) out.push_back(c + unit_from_angle(a0 + sweep * i / n) * r);
+}
+
+// points every `step` metres from a (excluded) to b (included)
+void append_line(std::vector<Vec2>& out, Vec2 a, Vec2 b, double step) {
+  const int n = std::max(1, static_cast<int>(std::ceil(distance(a, b) / step)));
+  for (int i = 1; i <= n; ++i) out.push_back(a + (b - a) * (static_cast<double>(i) / n));
+}
+
+// the skidpad's path from the rules' geometry: in, right circle twice, left twice, out
+std::vector<Vec2> skidpad_path(const world::SkidpadGeometry& g) {
+  const double step = 0.5;
+  std::vector<Vec2> p{g.entry_start};
+  append_line(p, g.entry_start, g.crossing, step);
+  const double a_right = angle_of(g.crossing - g.centre_right);
+  const double a_left = angle_of(g.crossing - g.centre_left);
+  append_arc(p, g.centre_right, g.radius, a_right, -4.0 * kPi, step);
+  append_arc(p, g.centre_left, g.radius, a_left, 4.0 * kPi, step);
+  // the lane ends in a cone: stop the base 5 m short of it (nose ~2.3 m ahead of the base)
+  const Vec2 out = g.exit_end - unit_from_angle(g.heading) * 5.0;
+  append_line(p, g.crossing, out, step);
+  return p;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+stack::MissionSpec mission_for(events::EventKind kind, const world::TrackModel& track) {
+  stack::MissionSpec m;
+  const events::Rules rules = events::rules_for(kind);
+  switch (kind) {
+    case events::EventKind::Trackdrive:
+    case events::EventKind::Autocross:
+      m.mission = kind == events::EventKind::Trackdrive ? stack::Mission::Trackdrive : stack::Mission::Autocross;
+      m.oracle_path = track.centreline;
+      m.oracle_closed = track.closed;
+      // the first crossing starts lap 1, so the finish is one more
+      if (!track.gates.empty()) m.finish_line = track.gates.front();
+      m.finish_crossings = rules.laps + 1;
+      break;
+    case events::EventKind::Acceleration:
+      m.mission = stack::Mission::Acceleration;
+      m.oracle_path = track.centreline;
+      m.oracle_closed = false;
+      if (track.gates.size() >= 2) m.finish_line = track.gates[1];
+      m.finish_crossings = 1;
+      break;
+    case events::EventKind::Skidpad:
+      // the path ends at rest in the exit lane; no finish-line counting
+      m.mission = stack::Mission::Skidpad;
+      if (track.skidpad) m.oracle_path = skidpad_path(*track.skidpad);
+      m.oracle_closed = false;
+      m.finish_crossings = 0;
+      break;
+  }
+  return m;
+}
+
+Pose2 start_pose(const world::TrackModel& track, double nose_offset) {
+  Pose2 start = track.start;
+  if (track.gates.empty()) return start;
+  // the nose's distance behind the gate's line, along the heading
+  const Segment& g = track.gates.front();
+  const Vec2 nose = start.transform({nose_offset, 0.0});
+  const Vec2 across = g.b - g.a;
+  const Vec2 forward = left_normal(across) / norm(across);  // from the gate's right side to its left
+  const double behind = dot(g.a - nose, forward);
+  const double clearance = 0.3;  // m, front of the car behind the start line
+  const double heading_along = dot(start.heading(), forward);
+  // only a start just at the line is moved (a start metres before it stays)
+  if (behind < clearance && behind > -nose_offset - 1.0 && heading_along > 0.5) {
+    const Vec2 shift = start.heading() * ((clearance - behind) / heading_along);
+    start.x -= shift.x;
+    start.y -= shift.y;
+  }
+  return start;
+}
+
+RunResult run(const Scenario& sc, const world::TrackModel& track) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  const vehicle::VehicleParams& vp = sc.vehicle;
+  const double dt = 1.0 / sc.sim.physics_rate;
+  const TimeNs dt_ns = kNsPerSecond / sc.sim.physics_rate;
+  const int control_every = sc.sim.physics_rate / sc.sim.control_rate;
+  const int log_every = sc.sim.physics_rate / sc.sim.log_rate;
+  const double log_dt = 1.0 / sc.sim.log_rate;
+
+  // the world: car at the start pose, at rest, brakes on; cones in place
+  const vehicle::Footprint footprint = vehicle::footprint(vp);
+  vehicle::VehicleState car = vehicle::initial_state(vp, start_pose(track, footprint.x_max));
+  world::ConeWorld cones(track.cones, sc.cones, world::Footprint{-footprint.x_min, footprint.x_max, footprint.y_max});
+  events::Event event(sc.scenario.event, track, sc.event);
+  stack::Stack stack(stack_params(sc), mission_for(sc.scenario.event, track));
+  SimHal hal;
+
+  vehicle::DriverInput input{0.0, 0.0, 1.0};
+  hal::AsState as = hal::AsState::Off;
+  const TimeNs go_ns = from_seconds(sc.scenario.go_time);
+  bool go_sent = false;
+
+  RunResult res;
+  res.log.reserve(static_cast<std::size_t>((sc.event.timeout + sc.scenario.go_time + 60.0) * sc.sim.log_rate));
+  auto nose_of = [&](const Pose2& base) { return base.transform({footprint.x_max, 0.0}); };
+
+  for (long k = 0;; ++k) {
+    const TimeNs now = k * dt_ns;
+    const double t = static_cast<double>(k) * dt;
+    Pose2 base = vehicle::base_pose(vp, car);
+
+    // the control cycle: sensors into the HAL, the stack, its command to the actuators
+    if (k % control_every == 0) {
+      const Vec2 v = vehicle::base_velocity(vp, car);
+      hal.post(hal::StateEstimate{now, base, v.x, v.y, car.r});
+      if (!go_sent && now >= go_ns) {
+        hal.post(hal::ResSignal{now, true, false});
+        go_sent = true;
+        event.start(t);
+      }
+      stack.tick(now, hal);
+      if (hal.command()) {
+        const hal::ActuatorCommand& c = *hal.command();
+        input = vehicle::DriverInput{c.steering_angle, c.throttle, c.brake};
+        as = c.as_state;
+      }
+      ++res.cycles;
+    }
+
+    // the sample: penalties, finish and DNF, and a log row
+    if (k % log_every == 0) {
+      const Vec2 v = vehicle::base_velocity(vp, car);
+      events::CarSample s;
+      s.t = t;
+      s.nose = nose_of(base);
+      s.wheels = vehicle::wheel_positions(vp, car);
+      s.speed = norm(v);
+      s.as_finished = as == hal::AsState::Finished;
+      s.as_emergency = as == hal::AsState::Emergency;
+      s.doo_total = cones.doo_count();
+      event.on_sample(s);
+
+      const stack::Telemetry& tm = stack.telemetry();
+      LogRow row;
+      row.t = t;
+      row.x = base.x;
+      row.y = base.y;
+      row.yaw = base.yaw;
+      row.vx = v.x;
+      row.vy = v.y;
+      row.yaw_rate = car.r;
+      row.steer_cmd = input.steering_angle;
+      row.steer = car.steering;
+      row.throttle = input.throttle;
+      row.brake = input.brake;
+      row.v_ref = tm.control.v_ref;
+      row.lateral_error = tm.control.lateral_error;
+      row.heading_error = tm.control.heading_error;
+      row.s = tm.control.s;
+      row.lap = event.current_lap();
+      row.as_state = static_cast<int>(as);
+      res.log.push_back(row);
+      if (event.done()) break;
+    }
+
+    // physics: the car, the cones it may hit, the timing gates
+    const Vec2 nose0 = nose_of(base);
+    vehicle::step(vp, car, input, dt);
+    base = vehicle::base_pose(vp, car);
+    const Vec2 v_world = rotate(vehicle::base_velocity(vp, car), base.yaw);
+    cones.step(base, v_world.x, v_world.y, car.r, dt);
+    event.on_motion(t, nose0, t + dt, nose_of(base));
+  }
+
+  res.event = event.result();
+  res.sim_time = res.log.empty() ? 0.0 : res.log.back().t;
+  res.fallbacks = stack.telemetry().fallbacks;
+  res.fault = stack.telemetry().last_fault;
+  for (const world::DooEvent& d : cones.doo_events()) {
+    const Cone& c = cones.cone(d.cone);
+    res.cones_hit.push_back({c.position, c.color, to_seconds(d.time_ns), d.cause == world::DooCause::Knocked});
+  }
+
+  // tracking errors per completed lap, from the log samples of that lap
+  const auto& laps = res.event.laps;
+  res.lap_tracking.assign(laps.size(), LapTracking{});
+  std::vector<double> sum2(laps.size(), 0.0);
+  std::vector<int> count(laps.size(), 0);
+  for (const LogRow& row : res.log) {
+    if (row.lap < 1 || row.lap > static_cast<int>(laps.size())) continue;
+    const auto i = static_cast<std::size_t>(row.lap - 1);
+    const double e = std::abs(row.lateral_error);
+    sum2[i] += e * e;
+    ++count[i];
+    res.lap_tracking[i].max = std::max(res.lap_tracking[i].max, e);
+    res.lap_tracking[i].itae += (row.t - laps[i].start) * e * log_dt;
+  }
+  double all2 = 0.0;
+  int all_n = 0;
+  for (std::size_t i = 0; i < laps.size(); ++i) {
+    res.lap_tracking[i].rms = count[i] > 0 ? std::sqrt(sum2[i] / count[i]) : 0.0;
+    all2 += sum2[i];
+    all_n += count[i];
+    res.tracking.max = std::max(res.tracking.max, res.lap_tracking[i].max);
+    res.tracking.itae += res.lap_tracking[i].itae / static_cast<double>(laps.size());
+  }
+  res.tracking.rms = all_n > 0 ? std::sqrt(all2 / all_n) : 0.0;
+  res.wall_time = seconds_since(wall0);
+  return res;
+}
+
+}  // namespace paddock::runner

@@ -1,0 +1,82 @@
+#pragma once
+// the closed loop: vehicle, cone world and event at the physics rate; the
+// stack behind the sim HAL at the control rate; log rows at the log rate.
+#include <string>
+#include <vector>
+
+#include "autonomy/stack/stack.h"
+#include "sim/events/event.h"
+#include "sim/runner/scenario.h"
+#include "sim/world/track.h"
+
+namespace paddock::runner {
+
+// one row of log.csv (100 Hz by default)
+struct LogRow {
+  double t = 0.0;          // sim time (s)
+  double x = 0.0;          // base frame (rear axle centre) in the map (m)
+  double y = 0.0;
+  double yaw = 0.0;        // rad
+  double vx = 0.0;         // base-frame velocity (m/s)
+  double vy = 0.0;
+  double yaw_rate = 0.0;   // rad/s
+  double steer_cmd = 0.0;  // commanded road-wheel angle (rad)
+  double steer = 0.0;      // actual road-wheel angle (rad)
+  double throttle = 0.0;   // commanded [0, 1]
+  double brake = 0.0;      // commanded [0, 1]
+  double v_ref = 0.0;      // reference speed (m/s)
+  double lateral_error = 0.0;  // front axle offset from the reference path, > 0 left (m)
+  double heading_error = 0.0;  // path heading - vehicle yaw (rad)
+  double s = 0.0;          // arc length of the projection on the reference (m)
+  int lap = 0;             // lap being driven, 0 before the first crossing
+  int as_state = 0;        // hal::AsState as an integer
+};
+
+// tracking errors over the timed laps (definitions in the README)
+struct Tracking {
+  double rms = 0.0;   // m
+  double max = 0.0;   // m
+  double itae = 0.0;  // m s^2, mean over the completed laps of integral (t - t_lap) |e| dt
+};
+
+struct LapTracking {
+  double rms = 0.0;
+  double max = 0.0;
+  double itae = 0.0;
+};
+
+// a cone that went down or out
+struct ConeHit {
+  Vec2 position;      // where it stood (m)
+  ConeColor color = ConeColor::Unknown;
+  double t = 0.0;     // sim time (s)
+  bool knocked = false;  // knocked over by an impact (else: displaced out of its place)
+};
+
+struct RunResult {
+  events::Result event;
+  std::vector<ConeHit> cones_hit;
+  std::vector<LapTracking> lap_tracking;  // one per completed lap
+  Tracking tracking;
+  std::vector<LogRow> log;
+  double sim_time = 0.0;   // s
+  double wall_time = 0.0;  // s
+  int fallbacks = 0;       // control cycles in the safe stop
+  std::string fault;       // the stack's last fault, if any
+  int cycles = 0;          // control cycles run
+};
+
+// the mission the car is given for an event on a track (planner = oracle: the
+// ground-truth path of the event)
+stack::MissionSpec mission_for(events::EventKind kind, const world::TrackModel& track);
+
+// where the car starts: the track's start pose, moved back along its heading
+// when that would put the car's nose less than 0.3 m behind the first gate
+// (the rules' start position; some files give the pose of the car's centre)
+Pose2 start_pose(const world::TrackModel& track, double nose_offset);
+
+// runs one scenario to its end (finish or DNF); deterministic for a given
+// scenario and build, apart from wall_time
+RunResult run(const Scenario& scenario, const world::TrackModel& track);
+
+}  // namespace paddock::runner

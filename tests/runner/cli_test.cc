@@ -1,0 +1,158 @@
+// the paddock program as a user runs it: exit codes, file:line messages,
+// output files, and determinism of a whole run
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include "sim/runner/files.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const std::string kRoot = PADDOCK_SOURCE_DIR;
+
+struct Outcome {
+  int code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+Outcome paddock(const std::string& args) {
+  const std::string cmd = std::string(PADDOCK_BINARY) + " " + args + " 2>&1";
+  Outcome o;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (!p) return o;
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) o.output.append(buf.data(), n);
+  const int status = pclose(p);
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return o;
+}
+
+std::string scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / "paddock_cli_test";
+  fs::create_directories(d);
+  return (d / name).string();
+}
+
+// a scenario in scenarios/ (so that its include resolves), removed afterwards
+struct TempScenario {
+  std::string path;
+  explicit TempScenario(const std::string& name, const std::string& text) : path(kRoot + "/scenarios/_cli_" + name + ".ini") {
+    std::ofstream(path) << text;
+  }
+  ~TempScenario() { fs::remove(path); }
+};
+
+TEST(Cli, MalformedIniIsAFileLineErrorAndExit2) {
+  TempScenario s("malformed", "include = vehicles/default.ini\n[scenario\ntrack = x\n");
+  const auto o = paddock("run " + s.path + " --out " + scratch("malformed"));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr(s.path + ":2: malformed section header"));
+}
+
+TEST(Cli, UnknownKeyIsAFileLineErrorAndExit2) {
+  TempScenario s("unknown", "include = vehicles/default.ini\n[scenario]\ntrack = ../tracks/fsg_2023.csv\nlaps = 3\n");
+  const auto o = paddock("run " + s.path + " --out " + scratch("unknown"));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr(s.path + ":4: unknown key 'laps' in [scenario]"));
+}
+
+TEST(Cli, BadOverrideIsAnErrorAndExit2) {
+  const auto o = paddock("run " + kRoot + "/scenarios/fsg_2023_trackdrive.ini --set control.lateral=lqr --out " + scratch("ov"));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr("--set:1: [control] lateral = 'lqr' is not known"));
+}
+
+TEST(Cli, MissingScenarioFileIsNamed) {
+  const auto o = paddock("run " + kRoot + "/scenarios/no_such.ini");
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr("no_such.ini: cannot open"));
+}
+
+TEST(Cli, MissingTrackFileIsNamed) {
+  TempScenario s("notrack", "include = vehicles/default.ini\n[scenario]\ntrack = ../tracks/nowhere.csv\n");
+  const auto o = paddock("run " + s.path + " --out " + scratch("notrack"));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr("nowhere.csv: cannot open"));
+}
+
+TEST(Cli, BadTrackFileIsAFileLineError) {
+  const std::string bad = scratch("bad_track.csv");
+  paddock::runner::write_file_atomic(bad, "tag,x,y\nblue,1,2\npurple,3,4\n");
+  TempScenario s("badtrack", "include = vehicles/default.ini\n[scenario]\ntrack = " + bad + "\n");
+  const auto o = paddock("run " + s.path + " --out " + scratch("badtrack"));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr(bad + ":3:"));
+  const auto c = paddock("check-track " + bad);
+  EXPECT_EQ(c.code, 2);
+  EXPECT_THAT(c.output, HasSubstr(bad + ":3:"));
+}
+
+TEST(Cli, CheckTrackDescribesEveryShippedTrack) {
+  std::string files;
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(kRoot + "/tracks")) {
+    if (e.path().extension() == ".csv") {
+      files += " " + e.path().string();
+      ++n;
+    }
+  }
+  const auto o = paddock("check-track" + files);
+  EXPECT_EQ(o.code, 0) << o.output;
+  EXPECT_EQ(n, 18);
+}
+
+std::string without_wall_clock(std::string json) {
+  // the two fields that measure the machine, not the run
+  json = std::regex_replace(json, std::regex("\"wall_time\":[^,]*,"), "");
+  return std::regex_replace(json, std::regex("\"realtime_factor\":[^,]*,"), "");
+}
+
+TEST(Cli, SameScenarioAndSeedGiveIdenticalSummaryAndLog) {
+  const std::string scenario = kRoot + "/scenarios/fsg_2023_trackdrive.ini";
+  const auto a = paddock("run " + scenario + " --out " + scratch("det_a"));
+  const auto b = paddock("run " + scenario + " --out " + scratch("det_b"));
+  ASSERT_EQ(a.code, 0) << a.output;
+  ASSERT_EQ(b.code, 0) << b.output;
+  const std::string log_a = paddock::runner::read_file(scratch("det_a") + "/log.csv");
+  const std::string log_b = paddock::runner::read_file(scratch("det_b") + "/log.csv");
+  EXPECT_GT(log_a.size(), 100000u);
+  EXPECT_TRUE(log_a == log_b) << "log.csv differs between two runs";
+  const std::string sum_a = paddock::runner::read_file(scratch("det_a") + "/summary.json");
+  const std::string sum_b = paddock::runner::read_file(scratch("det_b") + "/summary.json");
+  EXPECT_EQ(without_wall_clock(sum_a), without_wall_clock(sum_b));
+  EXPECT_THAT(sum_a, HasSubstr("\"finished\":true"));
+  // the resolved scenario is written next to the results and runs again the same
+  const auto c = paddock("run " + scratch("det_a") + "/scenario.ini --out " + scratch("det_c"));
+  ASSERT_EQ(c.code, 0) << c.output;
+  EXPECT_TRUE(paddock::runner::read_file(scratch("det_c") + "/log.csv") == log_a);
+}
+
+TEST(Cli, JsonSummaryCarriesTheSchema) {
+  const auto o = paddock("run " + kRoot + "/scenarios/fsg_2019_autocross.ini --json --out " + scratch("json"));
+  ASSERT_EQ(o.code, 0) << o.output;
+  for (const char* key : {"\"scenario\":", "\"event\":\"autocross\"", "\"finished\":", "\"laps\":[", "\"penalties\":{",
+                          "\"doo\":", "\"oc\":", "\"uss\":", "\"raw_time\":", "\"total_time\":", "\"sim_time\":",
+                          "\"wall_time\":", "\"realtime_factor\":", "\"tracking\":{", "\"rms\":", "\"max\":", "\"itae\":"}) {
+    EXPECT_THAT(o.output, HasSubstr(key));
+  }
+  EXPECT_EQ(o.output.front(), '{');
+}
+
+TEST(Cli, FailedExpectationsExitWith3AndSayWhich) {
+  TempScenario s("expect", "include = fsg_2019_autocross.ini\n[expect]\nlap_time_max = 5\n");
+  const auto o = paddock("run " + s.path + " --out " + scratch("expect"));
+  EXPECT_EQ(o.code, 3);
+  EXPECT_THAT(o.output, HasSubstr("lap 1 time: expected at most 5.000 s"));
+}
+
+}  // namespace

@@ -1,0 +1,142 @@
+// scenario compilation: unknown keys and bad values are file:line errors,
+// overrides go through the same checks, and the resolved file reads back the same
+#include "sim/runner/scenario.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "sim/runner/files.h"
+
+namespace paddock::runner {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const std::string kRoot = PADDOCK_SOURCE_DIR;
+const std::string kDefault = kRoot + "/scenarios/fsg_2023_trackdrive.ini";
+
+// a scenario file in scenarios/ (so that its includes resolve) for one test
+class ScenarioFile : public ::testing::Test {
+ protected:
+  void TearDown() override {
+    for (const auto& p : written_) fs::remove(p);
+  }
+  std::string write(const std::string& text) {
+    const std::string p = kRoot + "/scenarios/_test_" +
+                          ::testing::UnitTest::GetInstance()->current_test_info()->name() + ".ini";
+    std::ofstream(p) << text;
+    written_.push_back(p);
+    return p;
+  }
+  std::string error_of(const std::string& path, const std::vector<std::string>& overrides = {}) {
+    try {
+      load_scenario(path, overrides);
+    } catch (const UserError& e) {
+      return e.what();
+    }
+    return "(no error)";
+  }
+  std::vector<std::string> written_;
+};
+
+const char* kHead =
+    "include = vehicles/default.ini\n"
+    "[scenario]\n"
+    "track = ../tracks/fsg_2023.csv\n";
+
+TEST(Scenario, DefaultLoadsWithTheVehicleFile) {
+  const Scenario s = load_scenario(kDefault);
+  EXPECT_EQ(s.name, "fsg_2023_trackdrive");
+  EXPECT_EQ(s.scenario.event, events::EventKind::Trackdrive);
+  EXPECT_EQ(s.vehicle.mass, 190.0);  // ORACLES: the gotthard car
+  EXPECT_EQ(s.vehicle.tyre_b, 12.56);
+  EXPECT_TRUE(fs::exists(s.track_path)) << s.track_path;
+  EXPECT_EQ(s.control.lateral, control::LateralMode::Combined);
+}
+
+TEST_F(ScenarioFile, UnknownKeyNamesFileLineAndTheKnownKeys) {
+  const auto p = write(std::string(kHead) + "[control]\nlateral = combined\nstanly_k = 2\n");
+  const auto msg = error_of(p);
+  EXPECT_THAT(msg, HasSubstr(p + ":6: unknown key 'stanly_k' in [control]"));
+  EXPECT_THAT(msg, HasSubstr("stanley_k"));
+}
+
+TEST_F(ScenarioFile, UnknownSection) {
+  const auto p = write(std::string(kHead) + "[contrl]\nx = 1\n");
+  EXPECT_THAT(error_of(p), HasSubstr(p + ":5: unknown section [contrl]"));
+}
+
+TEST_F(ScenarioFile, BadValuesNameWhatWasExpected) {
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nstanley_k = fast\n")),
+              HasSubstr(":5: [control] stanley_k = 'fast' is not a number; expected a number in 1/s"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nlateral = mpc\n")),
+              HasSubstr(":5: [control] lateral = 'mpc' is not known; expected one of: combined, stanley, pure_pursuit"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nk_min = 1.5\n")),
+              HasSubstr(":5: [control] k_min = 1.5 is out of range; expected between 0 and 1"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[vehicle]\nmass = 190 lb\n")),
+              HasSubstr(":5: [vehicle] mass = '190 lb': unit 'lb' does not fit; expected a number in kg"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[sim]\nphysics_rate = 1000.5\n")),
+              HasSubstr(":5: [sim] physics_rate = '1000.5' is not an integer"));
+}
+
+TEST_F(ScenarioFile, UnitsConvertToSI) {
+  const auto p = write(std::string(kHead) + "[vehicle]\nsteering_max = 30 deg\n[planning]\nv_max = 72 km/h\n");
+  const Scenario s = load_scenario(p);
+  EXPECT_NEAR(s.vehicle.steering_max, 30.0 * M_PI / 180.0, 1e-15);
+  EXPECT_NEAR(s.planning.profile.v_max, 20.0, 1e-12);
+}
+
+TEST_F(ScenarioFile, MissingVehicleKeysAreNamed) {
+  const auto p = write("[scenario]\ntrack = ../tracks/fsg_2023.csv\n");
+  EXPECT_THAT(error_of(p), HasSubstr("[vehicle] mass is not set (kg); include a vehicle file"));
+}
+
+TEST_F(ScenarioFile, MissingTrackKeyIsNamed) {
+  const auto p = write("include = vehicles/default.ini\n");
+  EXPECT_THAT(error_of(p), HasSubstr("[scenario] track is not set"));
+}
+
+TEST(Scenario, OverridesWinAndAreChecked) {
+  const Scenario s = load_scenario(kDefault, {"control.lateral=stanley", "scenario.seed = 7"});
+  EXPECT_EQ(s.control.lateral, control::LateralMode::Stanley);
+  EXPECT_EQ(s.scenario.seed, 7u);
+  auto msg = [](const std::vector<std::string>& o) {
+    try {
+      load_scenario(kDefault, o);
+    } catch (const UserError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_THAT(msg({"control.lateral=mpc"}), HasSubstr("--set:1: [control] lateral = 'mpc' is not known"));
+  EXPECT_THAT(msg({"seed=3", }), HasSubstr("--set seed=3: expected section.key=value"));
+  EXPECT_THAT(msg({"scenario.seed=1", "control.nokey=1"}), HasSubstr("--set:2: unknown key 'nokey' in [control]"));
+}
+
+TEST(Scenario, ResolvedFileReadsBackToTheSameScenario) {
+  const Scenario a = load_scenario(kDefault, {"control.stanley_k=3.25", "vehicle.steering_max=25 deg"});
+  const std::string text = resolved_ini(a);
+  // every key is written, defaults included
+  for (const auto& f : scenario_fields()) {
+    if (f.section != "expect") {
+      EXPECT_THAT(text, HasSubstr("\n" + f.key + " = ")) << f.section << "." << f.key;
+    }
+  }
+  const std::string p = (fs::temp_directory_path() / "paddock_resolved_test.ini").string();
+  write_file_atomic(p, text);
+  const Scenario b = load_scenario(p);
+  // the same text apart from the "; from" line
+  const std::string again = resolved_ini(b);
+  EXPECT_EQ(again.substr(again.find("\n[scenario]")), text.substr(text.find("\n[scenario]")));
+  EXPECT_EQ(b.control.stanley.k, 3.25);
+  EXPECT_EQ(b.vehicle.steering_max, a.vehicle.steering_max);  // bit-exact through the text
+  fs::remove(p);
+}
+
+}  // namespace
+}  // namespace paddock::runner
