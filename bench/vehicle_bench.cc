@@ -1,0 +1,63 @@
+// the cost of one vehicle step (dt = 1 ms) in a corner at speed, fully dynamic.
+// The whole simulator must run at >= 500x real time, i.e. all of one millisecond of
+// physics in < 2 us: one vehicle step has to stay well under 1 us.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+#include "sim/vehicle/vehicle.h"
+
+namespace {
+
+using namespace paddock;
+using namespace paddock::vehicle;
+
+// the default car from scenarios/vehicles/default.ini (a bare key = value reader: the
+// scenario parser proper belongs to sim/runner)
+VehicleParams bench_params() {
+  const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/scenarios/vehicles/default.ini";
+  std::ifstream f(path);
+  if (!f) throw std::runtime_error("cannot open " + path);
+  VehicleParams p;
+  std::string line;
+  while (std::getline(f, line)) {
+    line = line.substr(0, line.find(';'));
+    const auto eq = line.find('=');
+    if (eq == std::string::npos) continue;
+    std::string key = line.substr(0, eq);
+    key.erase(0, key.find_first_not_of(" \t"));
+    key.erase(key.find_last_not_of(" \t") + 1);
+    for (const ParamField& field : param_fields()) {
+      if (key == field.name) p.*field.member = std::stod(line.substr(eq + 1));
+    }
+  }
+  const std::string problem = validate(p);
+  if (!problem.empty()) throw std::runtime_error(path + ": " + problem);
+  return p;
+}
+
+void BM_VehicleStepCornering(benchmark::State& st) {
+  const VehicleParams p = bench_params();
+  constexpr double dt = 1e-3;
+  VehicleState s = initial_state(p, Pose2{});
+  s.vx = 12.0;
+  // a steady left-hand corner at 12 m/s (steering 0.11 rad: radius ~14 m, ~1 g), the
+  // speed held by a proportional throttle, reached before timing
+  auto input = [&]() {
+    return DriverInput{0.11, std::fmin(std::fmax(0.1 + 0.5 * (12.0 - s.vx), 0.0), 1.0), 0.0};
+  };
+  for (int k = 0; k < 3000; ++k) step(p, s, input(), dt);
+  for (auto _ : st) {
+    step(p, s, input(), dt);
+    benchmark::DoNotOptimize(s);
+    benchmark::ClobberMemory();
+  }
+  st.counters["speed_mps"] = speed(s);
+  st.counters["ay_g"] = body_acceleration(s).y / kGravity;
+}
+BENCHMARK(BM_VehicleStepCornering);
+
+}  // namespace

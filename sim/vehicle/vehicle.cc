@@ -1,0 +1,617 @@
+#include "sim/vehicle/vehicle.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstdio>
+
+namespace paddock::vehicle {
+
+// ---------------------------------------------------------------------------
+// parameters
+// ---------------------------------------------------------------------------
+
+const std::vector<ParamField>& param_fields() {
+  static const std::vector<ParamField> fields = {
+      {"mass", &VehicleParams::mass, "kg"},
+      {"inertia_z", &VehicleParams::inertia_z, "kg m^2"},
+      {"lf", &VehicleParams::lf, "m"},
+      {"lr", &VehicleParams::lr, "m"},
+      {"h_cg", &VehicleParams::h_cg, "m"},
+      {"track_front", &VehicleParams::track_front, "m"},
+      {"track_rear", &VehicleParams::track_rear, "m"},
+      {"wheel_radius", &VehicleParams::wheel_radius, "m"},
+      {"tyre_b", &VehicleParams::tyre_b, "1/rad"},
+      {"tyre_c", &VehicleParams::tyre_c, "-"},
+      {"tyre_d", &VehicleParams::tyre_d, "-"},
+      {"tyre_e", &VehicleParams::tyre_e, "-"},
+      {"c_down", &VehicleParams::c_down, "N s^2/m^2"},
+      {"aero_balance_front", &VehicleParams::aero_balance_front, "-"},
+      {"c_drag", &VehicleParams::c_drag, "N s^2/m^2"},
+      {"cm1", &VehicleParams::cm1, "N"},
+      {"cr0", &VehicleParams::cr0, "N"},
+      {"drive_split_front", &VehicleParams::drive_split_front, "-"},
+      {"brake_force_max", &VehicleParams::brake_force_max, "N"},
+      {"brake_split_front", &VehicleParams::brake_split_front, "-"},
+      {"pitch_time_constant", &VehicleParams::pitch_time_constant, "s"},
+      {"steering_max", &VehicleParams::steering_max, "rad"},
+      {"steering_rate_max", &VehicleParams::steering_rate_max, "rad/s"},
+      {"steering_time_constant", &VehicleParams::steering_time_constant, "s"},
+      {"steering_dead_time", &VehicleParams::steering_dead_time, "s"},
+      {"throttle_time_constant", &VehicleParams::throttle_time_constant, "s"},
+      {"brake_time_constant", &VehicleParams::brake_time_constant, "s"},
+      {"front_overhang", &VehicleParams::front_overhang, "m"},
+      {"rear_overhang", &VehicleParams::rear_overhang, "m"},
+      {"body_width", &VehicleParams::body_width, "m"},
+  };
+  return fields;
+}
+
+namespace {
+
+// one range check: "<name> must be <what> <unit> (got <value>)" or empty
+struct Range {
+  const char* name;
+  double value;
+  double lo;
+  bool lo_open;  // lo excluded
+  double hi;
+  bool hi_open;  // hi excluded
+  const char* unit;
+};
+
+std::string check(const Range& c) {
+  char buf[256];
+  const bool has_hi = std::isfinite(c.hi);
+  const char* unit = (c.unit[0] == '-') ? "" : c.unit;
+  const char* sep = (unit[0] == '\0') ? "" : " ";
+  if (!std::isfinite(c.value)) {
+    std::snprintf(buf, sizeof buf, "%s must be set to a finite value (got %g)", c.name, c.value);
+    return buf;
+  }
+  const bool lo_ok = c.lo_open ? c.value > c.lo : c.value >= c.lo;
+  const bool hi_ok = !has_hi || (c.hi_open ? c.value < c.hi : c.value <= c.hi);
+  if (lo_ok && hi_ok) return {};
+  if (has_hi) {
+    std::snprintf(buf, sizeof buf, "%s must be in %c%g, %g%c%s%s (got %g)", c.name, c.lo_open ? '(' : '[',
+                  c.lo, c.hi, c.hi_open ? ')' : ']', sep, unit, c.value);
+  } else {
+    std::snprintf(buf, sizeof buf, "%s must be %s %g%s%s (got %g)", c.name, c.lo_open ? ">" : ">=", c.lo, sep,
+                  unit, c.value);
+  }
+  return buf;
+}
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+}  // namespace
+
+std::string validate(const VehicleParams& p) {
+  // open (excluded) and closed (included) bounds per field, in declaration order
+  const Range checks[] = {
+      {"mass", p.mass, 0.0, true, kInf, false, "kg"},
+      {"inertia_z", p.inertia_z, 0.0, true, kInf, false, "kg m^2"},
+      {"lf", p.lf, 0.0, true, kInf, false, "m"},
+      {"lr", p.lr, 0.0, true, kInf, false, "m"},
+      {"h_cg", p.h_cg, 0.0, false, kInf, false, "m"},
+      {"track_front", p.track_front, 0.0, true, kInf, false, "m"},
+      {"track_rear", p.track_rear, 0.0, true, kInf, false, "m"},
+      {"wheel_radius", p.wheel_radius, 0.0, true, kInf, false, "m"},
+      {"tyre_b", p.tyre_b, 0.0, true, kInf, false, "1/rad"},
+      // C >= 2 would make the force change sign at large slip
+      {"tyre_c", p.tyre_c, 0.0, true, 2.0, true, "-"},
+      {"tyre_d", p.tyre_d, 0.0, true, kInf, false, "-"},
+      // E <= 1 keeps B a - E (B a - atan(B a)) increasing in a
+      {"tyre_e", p.tyre_e, -kInf, false, 1.0, false, "-"},
+      {"c_down", p.c_down, 0.0, false, kInf, false, "N s^2/m^2"},
+      {"aero_balance_front", p.aero_balance_front, 0.0, false, 1.0, false, "-"},
+      {"c_drag", p.c_drag, 0.0, false, kInf, false, "N s^2/m^2"},
+      {"cm1", p.cm1, 0.0, false, kInf, false, "N"},
+      {"cr0", p.cr0, 0.0, false, kInf, false, "N"},
+      {"drive_split_front", p.drive_split_front, 0.0, false, 1.0, false, "-"},
+      {"brake_force_max", p.brake_force_max, 0.0, false, kInf, false, "N"},
+      {"brake_split_front", p.brake_split_front, 0.0, false, 1.0, false, "-"},
+      {"pitch_time_constant", p.pitch_time_constant, 0.0, true, kInf, false, "s"},
+      // below pi/2 so that tan(steering) of the kinematic model stays finite
+      {"steering_max", p.steering_max, 0.0, true, 1.5, false, "rad"},
+      {"steering_rate_max", p.steering_rate_max, 0.0, true, kInf, false, "rad/s"},
+      {"steering_time_constant", p.steering_time_constant, 0.0, false, kInf, false, "s"},
+      {"steering_dead_time", p.steering_dead_time, 0.0, false, kMaxSteeringDeadTime, false, "s"},
+      {"throttle_time_constant", p.throttle_time_constant, 0.0, false, kInf, false, "s"},
+      {"brake_time_constant", p.brake_time_constant, 0.0, false, kInf, false, "s"},
+      {"front_overhang", p.front_overhang, 0.0, false, kInf, false, "m"},
+      {"rear_overhang", p.rear_overhang, 0.0, false, kInf, false, "m"},
+      {"body_width", p.body_width, 0.0, true, kInf, false, "m"},
+  };
+  static_assert(sizeof checks / sizeof checks[0] == sizeof(VehicleParams) / sizeof(double),
+                "validate() must check every field of VehicleParams");
+  for (const Range& c : checks) {
+    std::string msg = check(c);
+    if (!msg.empty()) return msg;
+  }
+  return {};
+}
+
+// ---------------------------------------------------------------------------
+// tyre and blend
+// ---------------------------------------------------------------------------
+
+namespace {
+
+// the hot path spends most of its time in atan and sin (the tyre curve and the slip
+// angles: 24 atan and 8 sin per step), so it uses these two polynomial versions,
+// inlined so that the front and rear tyre overlap. Both are accurate to better than
+// 1e-13, far below anything physical; the tyre test checks them against libm.
+
+// atan(x) = t + t^3 P(t^2) after reducing |x| to |t| <= tan(pi/8):
+//   atan(a) = pi/4 + atan((a - 1) / (a + 1))  for tan(pi/8) < a <= tan(3 pi/8),
+//   atan(a) = pi/2 + atan(-1 / a)             above.
+// P: Chebyshev fit (mpmath chebyfit, degree 7 in t^2) of (atan(t) - t) / t^3 on
+// [0, tan^2(pi/8)]; its error on atan is below 5e-14. Evaluated with Estrin's scheme
+// (a shallower dependency chain than Horner's).
+inline double fast_atan(double x) {
+  constexpr double kTanPi8 = 0.41421356237309504880;   // tan(pi/8)
+  constexpr double kTan3Pi8 = 2.41421356237309504880;  // tan(3 pi/8)
+  const double a = std::abs(x);
+  double t, base;
+  if (a <= kTanPi8) {
+    t = a;
+    base = 0.0;
+  } else if (a <= kTan3Pi8) {
+    t = (a - 1.0) / (a + 1.0);
+    base = 0.25 * kPi;
+  } else {
+    t = -1.0 / a;  // inf -> -0, NaN stays NaN
+    base = 0.5 * kPi;
+  }
+  const double z = t * t;
+  const double z2 = z * z;
+  const double z4 = z2 * z2;
+  const double p01 = -0.33333333333266199 + 0.19999999949854793 * z;
+  const double p23 = -0.142857081103604 + 0.11110819716745676 * z;
+  const double p45 = -0.090841018953464295 + 0.076048000460782915 * z;
+  const double p67 = -0.060273074609466753 + 0.032956795418701366 * z;
+  const double p = (p01 + z2 * p23) + z4 * (p45 + z2 * p67);
+  return std::copysign(base + (t + t * z * p), x);
+}
+
+// sin(x) = u + u^3 Q(u^2) for |x| <= pi, with u = |x| folded into [0, pi/2] by
+// sin(a) = sin(pi - a). Q: Chebyshev fit (degree 6 in u^2) of (sin(u) - u) / u^3 on
+// [0, (pi/2)^2]; its error on sin is below 1e-15 (plus the rounding of pi - a).
+// Outside [-pi, pi] (never reached by the tyre: |C atan(.)| < pi for C < 2) it defers to libm.
+inline double fast_sin(double x) {
+  const double a = std::abs(x);
+  if (!(a <= kPi)) return std::sin(x);
+  const double u = a > 0.5 * kPi ? kPi - a : a;
+  const double z = u * u;
+  const double z2 = z * z;
+  const double z4 = z2 * z2;
+  const double q01 = -0.16666666666666648 + 0.0083333333333259327 * z;
+  const double q23 = -0.00019841269836469025 + 2.7557318055685784e-6 * z;
+  const double q45 = -2.5051972921545552e-8 + 1.6050972244135635e-10 * z;
+  const double q = (q01 + z2 * q23) + z4 * (q45 + z2 * -7.4080548895426099e-13);
+  return std::copysign(u + u * z * q, x);
+}
+
+// atan2(y, x) for the slip angles: atan(y / x) while moving forward, libm otherwise
+inline double slip_atan2(double y, double x) { return x > 0.0 ? fast_atan(y / x) : std::atan2(y, x); }
+
+}  // namespace
+
+// Pacejka magic formula, lateral, without shifts:
+//   mu_y(a) = D sin(C atan(B a - E (B a - atan(B a))))
+//   Fy      = -mu_y(a) Fz      (the force opposes the slip angle)
+// FSSIM writes the same curve as D sin(C atan(B (1 - E) a + E atan(B a))) with C = -1.38,
+// which folds the minus sign into C (sin and atan are odd).
+namespace {
+inline double tyre_mu(const VehicleParams& p, double alpha) {
+  const double ba = p.tyre_b * alpha;
+  return p.tyre_d * fast_sin(p.tyre_c * fast_atan(ba - p.tyre_e * (ba - fast_atan(ba))));
+}
+}  // namespace
+
+double tyre_lateral_force(const VehicleParams& p, double alpha, double fz) { return -tyre_mu(p, alpha) * fz; }
+
+// FSSIM: lambda = clamp(0.5 (|v| - 1.5), 0, 1)
+double dynamic_weight(double speed_abs) { return std::clamp(0.5 * (speed_abs - 1.5), 0.0, 1.0); }
+
+// ---------------------------------------------------------------------------
+// the model
+// ---------------------------------------------------------------------------
+//
+// Single-track model at the CG, body frame (x forward, y left), yaw rate r.
+// Newton in the rotating body frame: the inertial acceleration of the CG is
+//   a = d/dt (vx, vy) + r x (vx, vy) = (vx' - r vy, vy' + r vx),
+// so with the front axle forces (Fxf, Fyf) in the wheel frame, steered by delta,
+// and the rear axle forces (Fxr, Fyr) in the body frame:
+//   m (vx' - r vy) = Fxf cos(delta) - Fyf sin(delta) + Fxr + Fres
+//   m (vy' + r vx) = Fxf sin(delta) + Fyf cos(delta) + Fyr
+//   Iz r'          = lf (Fxf sin(delta) + Fyf cos(delta)) - lr Fyr
+// where Fres = -c_drag vx |vx| - Cr0 sat(vx) collects drag and rolling resistance
+// (applied at the CG along x). The pose follows from rotating the body velocity:
+//   X' = vx cos(yaw) - vy sin(yaw),  Y' = vx sin(yaw) + vy cos(yaw),  yaw' = r.
+//
+// Slip angles: the axle velocities in the body frame are (vx, vy + lf r) at the
+// front and (vx, vy - lr r) at the rear; a slip angle is the angle of that velocity
+// from the wheel heading:
+//   alpha_f = atan2(vy + lf r, vx) - delta,   alpha_r = atan2(vy - lr r, vx).
+// The sideslip angle of the CG is beta = atan2(vy, vx); it is not a state here
+// (vy is), and at low speed it is undefined, which is why the slip angles are
+// evaluated only where the dynamic model has weight (|v| > 1.5 m/s).
+//
+// Kinematic model (FSSIM, no tyre slip): the rear axle moves along the body x axis
+// and the front axle along the front wheel, so with the speed of the rear axle vx
+//   r_kin = vx tan(delta) / L,   vy_kin = lr r_kin,   m vx' = Fxf + Fxr + Fres.
+// As a state derivative: vy, r track their kinematic values through
+//   r'  = d/dt r_kin  + (r_kin  - r)  / tau_kin,
+//   vy' = d/dt vy_kin + (vy_kin - vy) / tau_kin,
+//   d/dt r_kin = (vx' tan(delta) + vx delta' / cos^2(delta)) / L,
+// the first term keeps them exactly on the kinematic values once there, the second
+// pulls them there when the car enters the kinematic regime with a residual slip
+// (FSSIM overwrites them after each step, i.e. tau_kin = dt).
+// The state derivative is lambda * f_dyn + (1 - lambda) * f_kin (pose and actuator
+// rows are the same in both models).
+//
+// Normal loads per axle: static share + aero share + longitudinal load transfer
+//   Fzf = m g lr / L + bal c_down vx^2       - m ax_load h_cg / L
+//   Fzr = m g lf / L + (1 - bal) c_down vx^2 + m ax_load h_cg / L
+// The transfer uses ax_load, a state that follows the CG acceleration ax through a
+// first-order lag (the pitch dynamics of the suspension):
+//   ax_load' = (ax - ax_load) / pitch_time_constant.
+// ax depends on the normal loads (through the friction limits), so using ax itself
+// would be an algebraic loop; the lag breaks it without iteration.
+//
+// Longitudinal force per axle: motor (throttle cm1 split front/rear) minus brake
+// (brake F_brake_max split front/rear, opposing vx), limited by the friction ellipse
+// (Fx/(D Fz))^2 + (Fy/(D Fz))^2 <= 1. The lateral force has priority:
+//   |Fx| <= sqrt((D Fz)^2 - Fy^2)
+// because the lateral curve is the FSSIM reference (kept unchanged it keeps the
+// lateral dynamics and the tyre oracle identical), and because the longitudinal force
+// here is an actuator demand with no slip model: clipping it is what the car's traction
+// control and ABS do, whereas clipping Fy would make a full-brake demand steal the
+// cornering force, which an ABS prevents.
+
+namespace {
+
+// the integrated state: rigid body, actuators, load transfer
+struct X {
+  double px, py, yaw, vx, vy, r, steer, thr, brk, ax_load;
+};
+
+inline X axpy(const X& s, double h, const X& k) {
+  return {s.px + h * k.px,       s.py + h * k.py,         s.yaw + h * k.yaw, s.vx + h * k.vx,
+          s.vy + h * k.vy,       s.r + h * k.r,           s.steer + h * k.steer,
+          s.thr + h * k.thr,     s.brk + h * k.brk,       s.ax_load + h * k.ax_load};
+}
+
+// a state derivative, plus the CG acceleration in the body frame it implies
+struct Deriv {
+  X d;
+  double ax;  // m/s^2, vx' - r vy
+  double ay;  // m/s^2, vy' + r vx
+};
+
+// kinematic tracking time constant, s: how fast vy and r settle on their kinematic
+// values when the car enters the kinematic regime with a residual slip. Its rate
+// 1/tau_kin = 100 1/s gives |z| = dt / tau_kin = 0.1 at 1 kHz, far inside the RK4
+// stability interval (|z| < 2.785), and is fast compared with the vehicle motion.
+constexpr double kKinematicTimeConstant = 0.01;
+
+// smallest regularisation speed of the standstill forces, m/s (see standstill_speed)
+constexpr double kMinStandstillSpeed = 0.02;
+
+struct SinCos {
+  double s, c;
+};
+
+// sin and cos of a, given them at a nearby a0: rotate (cos a0, sin a0) by d = a - a0
+// with Taylor series, d - d^3/6 + d^5/120 and 1 - d^2/2 + d^4/24 - d^6/720, whose
+// truncation errors (d^7/5040, d^8/40320) are below 1e-17 for |d| <= 0.01. Within one
+// step yaw moves by r dt (< 0.01 rad below 10 rad/s at 1 kHz) and the steering by at
+// most steering_rate_max dt, so RK4's stages need no sin/cos call; larger moves fall
+// back to the library.
+inline SinCos sincos_near(double a, double a0, SinCos at_a0) {
+  const double d = a - a0;
+  if (!(std::abs(d) <= 0.01)) return {std::sin(a), std::cos(a)};
+  const double d2 = d * d;
+  const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
+  const double cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
+  return {at_a0.s * cd + at_a0.c * sd, at_a0.c * cd - at_a0.s * sd};
+}
+
+// everything constant over one step
+struct Model {
+  const VehicleParams* p;
+  double inv_m, inv_iz, wheelbase, inv_l;
+  double fz_front_static, fz_rear_static;  // N
+  double load_transfer_gain;               // N per m/s^2: m h_cg / L
+  double inv_v_reg;                        // 1 / (m/s): standstill regularisation
+  double inv_tau_steer, inv_tau_thr, inv_tau_brk, inv_tau_pitch;  // 1/s, 0 = instantaneous (set outside RK4)
+  // commands after dead time and limits
+  double steer_cmd, thr_cmd, brk_cmd;
+  // yaw and steering at the start of the step, with their sines and cosines
+  double yaw0, steer0;
+  SinCos yaw0_sc, steer0_sc;
+};
+
+// standstill regularisation: sat(vx) = clamp(vx / v_reg, -1, 1) replaces sign(vx) in
+// the rolling resistance and the brakes, so that at vx = 0 they are exactly zero (no
+// creeping, the car at rest stays at rest) and near vx = 0 they are a linear damper.
+// Stiffness limit: inside |vx| < v_reg they act as m vx' = -c vx with
+// c = (F_brake_max + Cr0) / v_reg, eigenvalue lambda = -c / m. RK4's amplification
+// R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24, z = lambda dt, is stable for z > -2.785
+// and stays in (0, 1) there, so vx decays monotonically and never changes sign (no
+// rolling backwards under braking). Above v_reg the deceleration is at most
+// a_max = (F_brake_max + Cr0 + F_drag) / m, and one step cannot jump over the band
+// [0, v_reg] if a_max dt <= v_reg. Both hold with margin for
+//   v_reg = 2 (F_brake_max + Cr0) dt / m   (z = -0.5, and drag up to F_brake_max + Cr0),
+// floored at 2 cm/s; with the default car at 1 kHz, v_reg = 3.9 cm/s.
+double standstill_speed_impl(const VehicleParams& p, double dt) {
+  return std::max(kMinStandstillSpeed, 2.0 * (p.brake_force_max + p.cr0) * dt / p.mass);
+}
+
+// first-order lag rate, 0 (= instantaneous, applied outside RK4) when tau < dt/2:
+// such a lag is not resolvable at this step and explicit RK4 would go unstable for
+// dt / tau > 2.785
+inline double lag_rate(double tau, double dt) { return tau < 0.5 * dt ? 0.0 : 1.0 / tau; }
+
+// the state derivative
+Deriv derivative(const Model& m, const X& s) {
+  const VehicleParams& p = *m.p;
+  Deriv out{};
+  X& d = out.d;
+
+  // actuators: first-order lags, steering also rate limited
+  d.steer = std::clamp((m.steer_cmd - s.steer) * m.inv_tau_steer, -p.steering_rate_max, p.steering_rate_max);
+  d.thr = (m.thr_cmd - s.thr) * m.inv_tau_thr;
+  d.brk = (m.brk_cmd - s.brk) * m.inv_tau_brk;
+
+  // aero: downforce and drag grow with vx^2
+  const double vx2 = s.vx * s.vx;
+  const double f_down = p.c_down * vx2;
+  const double f_drag = p.c_drag * s.vx * std::abs(s.vx);
+
+  // normal loads: static + aero + lagged longitudinal load transfer
+  const double transfer = m.load_transfer_gain * s.ax_load;
+  const double fz_f = std::max(0.0, m.fz_front_static + p.aero_balance_front * f_down - transfer);
+  const double fz_r = std::max(0.0, m.fz_rear_static + (1.0 - p.aero_balance_front) * f_down + transfer);
+
+  // standstill regularisation of the forces that oppose motion
+  const double sat = std::clamp(s.vx * m.inv_v_reg, -1.0, 1.0);
+
+  // longitudinal demand per axle (wheel frame): motor minus brake
+  const double f_motor = s.thr * p.cm1;
+  const double f_brake = s.brk * p.brake_force_max * sat;
+  const double fx_f_demand = p.drive_split_front * f_motor - p.brake_split_front * f_brake;
+  const double fx_r_demand = (1.0 - p.drive_split_front) * f_motor - (1.0 - p.brake_split_front) * f_brake;
+  const double f_res = -f_drag - p.cr0 * sat;
+
+  // blend weight of the dynamic model
+  const double v = std::sqrt(vx2 + s.vy * s.vy);
+  const double lambda = dynamic_weight(v);
+
+  // lateral tyre forces, only where the dynamic model has weight (no slip angle at rest)
+  double fy_f = 0.0, fy_r = 0.0;
+  if (lambda > 0.0) {
+    const double alpha_f = slip_atan2(s.vy + p.lf * s.r, s.vx) - s.steer;
+    const double alpha_r = slip_atan2(s.vy - p.lr * s.r, s.vx);
+    fy_f = -tyre_mu(p, alpha_f) * fz_f;
+    fy_r = -tyre_mu(p, alpha_r) * fz_r;
+  }
+
+  // friction ellipse per axle, lateral first: |Fx| <= sqrt((D Fz)^2 - Fy^2)
+  const double fmax_f = p.tyre_d * fz_f;
+  const double fmax_r = p.tyre_d * fz_r;
+  const double fx_lim_f = fy_f == 0.0 ? fmax_f : std::sqrt(std::max(0.0, fmax_f * fmax_f - fy_f * fy_f));
+  const double fx_lim_r = fy_r == 0.0 ? fmax_r : std::sqrt(std::max(0.0, fmax_r * fmax_r - fy_r * fy_r));
+  const double fx_f = std::clamp(fx_f_demand, -fx_lim_f, fx_lim_f);
+  const double fx_r = std::clamp(fx_r_demand, -fx_lim_r, fx_lim_r);
+
+  const SinCos steer_sc = sincos_near(s.steer, m.steer0, m.steer0_sc);
+  const double sd = steer_sc.s;
+  const double cd = steer_sc.c;
+
+  // kinematic and dynamic velocity derivatives, blended
+  double vx_dot = 0.0, vy_dot = 0.0, r_dot = 0.0;
+  if (lambda < 1.0) {
+    const double vx_dot_k = (fx_f + fx_r + f_res) * m.inv_m;
+    const double td = sd / cd;
+    const double r_kin = s.vx * td * m.inv_l;
+    const double r_kin_dot = (vx_dot_k * td + s.vx * d.steer / (cd * cd)) * m.inv_l;
+    const double w = 1.0 - lambda;
+    vx_dot += w * vx_dot_k;
+    r_dot += w * (r_kin_dot + (r_kin - s.r) * (1.0 / kKinematicTimeConstant));
+    vy_dot += w * (p.lr * r_kin_dot + (p.lr * r_kin - s.vy) * (1.0 / kKinematicTimeConstant));
+  }
+  if (lambda > 0.0) {
+    const double fy_f_body = fx_f * sd + fy_f * cd;  // front axle force along body y
+    vx_dot += lambda * (s.r * s.vy + (fx_f * cd - fy_f * sd + fx_r + f_res) * m.inv_m);
+    vy_dot += lambda * (-s.r * s.vx + (fy_f_body + fy_r) * m.inv_m);
+    r_dot += lambda * ((p.lf * fy_f_body - p.lr * fy_r) * m.inv_iz);
+  }
+  d.vx = vx_dot;
+  d.vy = vy_dot;
+  d.r = r_dot;
+
+  // the CG acceleration in the body frame, and the suspension's lagged copy of ax
+  out.ax = vx_dot - s.r * s.vy;
+  out.ay = vy_dot + s.r * s.vx;
+  d.ax_load = (out.ax - s.ax_load) * m.inv_tau_pitch;
+
+  // pose: rotate the body velocity into the map
+  const SinCos yaw_sc = sincos_near(s.yaw, m.yaw0, m.yaw0_sc);
+  const double cy = yaw_sc.c;
+  const double sy = yaw_sc.s;
+  d.px = s.vx * cy - s.vy * sy;
+  d.py = s.vx * sy + s.vy * cy;
+  d.yaw = s.r;
+  return out;
+}
+
+// a command replaced by a safe value when it is not finite (NaN from a broken
+// controller must not poison the state)
+inline double finite_or(double v, double fallback) { return std::isfinite(v) ? v : fallback; }
+
+}  // namespace
+
+double standstill_speed(const VehicleParams& p, double dt) { return standstill_speed_impl(p, dt); }
+
+VehicleState initial_state(const VehicleParams& p, Pose2 base_pose_in) {
+  VehicleState s;
+  // the CG lies lr ahead of the rear axle centre
+  const Vec2 cg = base_pose_in.transform({p.lr, 0.0});
+  s.x = cg.x;
+  s.y = cg.y;
+  s.yaw = wrap_angle(base_pose_in.yaw);
+  return s;
+}
+
+void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
+  assert(dt > 0.0);
+
+  // commands: non-finite ones replaced by safe values, then limited
+  const double steer_req = std::clamp(finite_or(in.steering_angle, s.steering), -p.steering_max, p.steering_max);
+  const double thr_cmd = std::clamp(finite_or(in.throttle, 0.0), 0.0, 1.0);
+  const double brk_cmd = std::clamp(finite_or(in.brake, 1.0), 0.0, 1.0);
+
+  // steering dead time: a ring buffer of the last n commands; n rounded to whole steps
+  double steer_cmd = steer_req;
+  if (p.steering_dead_time > 0.0) {
+    constexpr std::size_t cap = kMaxDelaySteps + 1;
+    auto n = static_cast<std::size_t>(std::lround(p.steering_dead_time / dt));
+    assert(n <= kMaxDelaySteps && "steering_dead_time / dt exceeds the delay line");
+    n = std::min(n, kMaxDelaySteps);
+    s.steering_delay[s.delay_head] = steer_req;
+    steer_cmd = s.steering_delay[(s.delay_head + cap - n) % cap];
+    s.delay_head = (s.delay_head + 1) % cap;
+  }
+
+  // the model for this step
+  Model m;
+  m.p = &p;
+  m.inv_m = 1.0 / p.mass;
+  m.inv_iz = 1.0 / p.inertia_z;
+  m.wheelbase = p.lf + p.lr;
+  m.inv_l = 1.0 / m.wheelbase;
+  m.fz_front_static = p.mass * kGravity * p.lr * m.inv_l;
+  m.fz_rear_static = p.mass * kGravity * p.lf * m.inv_l;
+  m.load_transfer_gain = p.mass * p.h_cg * m.inv_l;
+  m.inv_v_reg = 1.0 / standstill_speed_impl(p, dt);
+  m.inv_tau_steer = lag_rate(p.steering_time_constant, dt);
+  m.inv_tau_thr = lag_rate(p.throttle_time_constant, dt);
+  m.inv_tau_brk = lag_rate(p.brake_time_constant, dt);
+  // the pitch lag breaks the load-transfer loop, so it is never instantaneous:
+  // shorter than dt/2 it is stretched to dt/2 (|z| = 2 < 2.785, still stable)
+  m.inv_tau_pitch = 1.0 / std::max(p.pitch_time_constant, 0.5 * dt);
+  m.steer_cmd = steer_cmd;
+  m.thr_cmd = thr_cmd;
+  m.brk_cmd = brk_cmd;
+
+  // instantaneous actuators jump to the command at the start of the step
+  // (steering still rate limited), and are held over the step
+  if (m.inv_tau_steer == 0.0) {
+    const double max_move = p.steering_rate_max * dt;
+    s.steering += std::clamp(steer_cmd - s.steering, -max_move, max_move);
+  }
+  if (m.inv_tau_thr == 0.0) s.throttle = thr_cmd;
+  if (m.inv_tau_brk == 0.0) s.brake = brk_cmd;
+
+  // classic RK4
+  const X x0{s.x, s.y, s.yaw, s.vx, s.vy, s.r, s.steering, s.throttle, s.brake, s.ax_load};
+  m.yaw0 = x0.yaw;
+  m.yaw0_sc = {std::sin(x0.yaw), std::cos(x0.yaw)};
+  m.steer0 = x0.steer;
+  m.steer0_sc = {std::sin(x0.steer), std::cos(x0.steer)};
+  const double h = 0.5 * dt;
+  const Deriv k1 = derivative(m, x0);
+  const Deriv k2 = derivative(m, axpy(x0, h, k1.d));
+  const Deriv k3 = derivative(m, axpy(x0, h, k2.d));
+  const Deriv k4 = derivative(m, axpy(x0, dt, k3.d));
+  X k;
+  k.px = k1.d.px + 2.0 * (k2.d.px + k3.d.px) + k4.d.px;
+  k.py = k1.d.py + 2.0 * (k2.d.py + k3.d.py) + k4.d.py;
+  k.yaw = k1.d.yaw + 2.0 * (k2.d.yaw + k3.d.yaw) + k4.d.yaw;
+  k.vx = k1.d.vx + 2.0 * (k2.d.vx + k3.d.vx) + k4.d.vx;
+  k.vy = k1.d.vy + 2.0 * (k2.d.vy + k3.d.vy) + k4.d.vy;
+  k.r = k1.d.r + 2.0 * (k2.d.r + k3.d.r) + k4.d.r;
+  k.steer = k1.d.steer + 2.0 * (k2.d.steer + k3.d.steer) + k4.d.steer;
+  k.thr = k1.d.thr + 2.0 * (k2.d.thr + k3.d.thr) + k4.d.thr;
+  k.brk = k1.d.brk + 2.0 * (k2.d.brk + k3.d.brk) + k4.d.brk;
+  k.ax_load = k1.d.ax_load + 2.0 * (k2.d.ax_load + k3.d.ax_load) + k4.d.ax_load;
+  const X x1 = axpy(x0, dt / 6.0, k);
+
+  s.x = x1.px;
+  s.y = x1.py;
+  s.yaw = x1.yaw;
+  if (s.yaw >= kPi || s.yaw < -kPi) s.yaw = wrap_angle(s.yaw);
+  s.vx = x1.vx;
+  s.vy = x1.vy;
+  s.r = x1.r;
+  // the lags approach their (limited) commands without overshoot (RK4's R(z) is in
+  // (0, 1) for the stable z); the clamps only guard the last ulp
+  s.steering = std::clamp(x1.steer, -p.steering_max, p.steering_max);
+  s.throttle = std::clamp(x1.thr, 0.0, 1.0);
+  s.brake = std::clamp(x1.brk, 0.0, 1.0);
+  s.ax_load = x1.ax_load;
+
+  // mean accelerations over the step, with RK4's weights
+  s.ax = (k1.ax + 2.0 * (k2.ax + k3.ax) + k4.ax) / 6.0;
+  s.ay = (k1.ay + 2.0 * (k2.ay + k3.ay) + k4.ay) / 6.0;
+  s.yaw_accel = k.r / 6.0;
+}
+
+// ---------------------------------------------------------------------------
+// accessors
+// ---------------------------------------------------------------------------
+
+Pose2 base_pose(const VehicleParams& p, const VehicleState& s) {
+  const double c = std::cos(s.yaw), sn = std::sin(s.yaw);
+  return {s.x - p.lr * c, s.y - p.lr * sn, s.yaw};
+}
+
+// rigid body: v_base = v_cg + r x (-lr, 0) = (vx, vy - lr r)
+Vec2 base_velocity(const VehicleParams& p, const VehicleState& s) { return {s.vx, s.vy - p.lr * s.r}; }
+
+Vec2 body_acceleration(const VehicleState& s) { return {s.ax, s.ay}; }
+
+double speed(const VehicleState& s) { return std::sqrt(s.vx * s.vx + s.vy * s.vy); }
+
+namespace {
+// contact patches in the body frame relative to the CG: FL, FR, RL, RR
+std::array<Vec2, 4> wheel_offsets_cg(const VehicleParams& p) {
+  return {Vec2{p.lf, 0.5 * p.track_front}, Vec2{p.lf, -0.5 * p.track_front}, Vec2{-p.lr, 0.5 * p.track_rear},
+          Vec2{-p.lr, -0.5 * p.track_rear}};
+}
+}  // namespace
+
+std::array<Vec2, 4> wheel_positions(const VehicleParams& p, const VehicleState& s) {
+  const Pose2 cg{s.x, s.y, s.yaw};
+  std::array<Vec2, 4> out;
+  const std::array<Vec2, 4> off = wheel_offsets_cg(p);
+  for (std::size_t i = 0; i < 4; ++i) out[i] = cg.transform(off[i]);
+  return out;
+}
+
+std::array<double, 4> wheel_speeds(const VehicleParams& p, const VehicleState& s) {
+  const std::array<Vec2, 4> off = wheel_offsets_cg(p);
+  const Vec2 front_heading{std::cos(s.steering), std::sin(s.steering)};
+  std::array<double, 4> out;
+  for (std::size_t i = 0; i < 4; ++i) {
+    // velocity of the contact point: v_cg + r x offset
+    const Vec2 v{s.vx - s.r * off[i].y, s.vy + s.r * off[i].x};
+    const Vec2 heading = i < 2 ? front_heading : Vec2{1.0, 0.0};
+    out[i] = dot(v, heading) / p.wheel_radius;
+  }
+  return out;
+}
+
+Footprint footprint(const VehicleParams& p) {
+  Footprint f;
+  f.x_min = -p.rear_overhang;
+  f.x_max = p.lf + p.lr + p.front_overhang;
+  f.y_min = -0.5 * p.body_width;
+  f.y_max = 0.5 * p.body_width;
+  return f;
+}
+
+}  // namespace paddock::vehicle

@@ -1,0 +1,163 @@
+#pragma once
+// the vehicle model: a dynamic single-track (bicycle) model with Pacejka lateral
+// tyres, a friction ellipse per axle, aero, a low-speed blend to the kinematic
+// model (as in AMZ FSSIM), and lagged, rate-limited actuators with an optional
+// steering dead time.
+//
+// MuJoCo style: a constant model (VehicleParams) + mutable state (VehicleState)
+// + a free function step(). Many vehicles can be simulated side by side; nothing
+// here allocates, reads files or keeps global mutable state.
+#include <array>
+#include <cstddef>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "autonomy/common/geometry.h"
+
+namespace paddock::vehicle {
+
+inline constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
+
+// every physical parameter of the car. No defaults in code: each field starts as
+// NaN and gets its value from scenarios/vehicles/default.ini (keys = field names);
+// validate() rejects a field left unset.
+struct VehicleParams {
+  // mass and geometry
+  double mass = kUnset;               // kg, total mass of the car
+  double inertia_z = kUnset;          // kg m^2, yaw moment of inertia about the CG
+  double lf = kUnset;                 // m, CG to front axle (along x)
+  double lr = kUnset;                 // m, CG to rear axle (along x)
+  double h_cg = kUnset;               // m, CG height above ground (longitudinal load transfer)
+  double track_front = kUnset;        // m, distance between the front contact patches
+  double track_rear = kUnset;         // m, distance between the rear contact patches
+  double wheel_radius = kUnset;       // m, dynamic rolling radius
+  // tyre: Pacejka magic formula, lateral, mu_y(a) = D sin(C atan(B a - E (B a - atan(B a))))
+  double tyre_b = kUnset;             // 1/rad, stiffness factor B
+  double tyre_c = kUnset;             // -, shape factor C
+  double tyre_d = kUnset;             // -, peak friction coefficient D (also the friction ellipse radius)
+  double tyre_e = kUnset;             // -, curvature factor E
+  // aero
+  double c_down = kUnset;             // N s^2/m^2, downforce F = c_down vx^2
+  double aero_balance_front = kUnset; // -, share of the downforce on the front axle
+  double c_drag = kUnset;             // N s^2/m^2, drag F = c_drag vx^2
+  // drivetrain and brakes
+  double cm1 = kUnset;                // N, motor force at full throttle (all driven wheels)
+  double cr0 = kUnset;                // N, rolling resistance
+  double drive_split_front = kUnset;  // -, share of the motor force on the front axle
+  double brake_force_max = kUnset;    // N, total brake force at full brake
+  double brake_split_front = kUnset;  // -, share of the brake force on the front axle (brake balance)
+  // load transfer
+  double pitch_time_constant = kUnset; // s, lag of the longitudinal load transfer behind the acceleration (pitch dynamics)
+  // actuators
+  double steering_max = kUnset;       // rad, road-wheel angle limit (symmetric)
+  double steering_rate_max = kUnset;  // rad/s, road-wheel angle rate limit
+  double steering_time_constant = kUnset; // s, first-order lag of the steering actuator (< dt/2: instantaneous)
+  double steering_dead_time = kUnset; // s, pure delay on the steering command (rounded to whole steps)
+  double throttle_time_constant = kUnset; // s, first-order lag of the motor force (< dt/2: instantaneous)
+  double brake_time_constant = kUnset;    // s, first-order lag of the brake force (< dt/2: instantaneous)
+  // footprint for collisions (a rectangle in the base frame)
+  double front_overhang = kUnset;     // m, front axle to the front of the car (nose, front wing)
+  double rear_overhang = kUnset;      // m, rear axle to the back of the car
+  double body_width = kUnset;         // m, overall width (tyres included)
+};
+
+// one field of VehicleParams, for the INI loader and writer: the key is the field name
+struct ParamField {
+  const char* name;
+  double VehicleParams::*member;
+  const char* unit;
+};
+// every field of VehicleParams, in declaration order
+const std::vector<ParamField>& param_fields();
+
+// the longest steering dead time the state's delay line can hold, in steps
+inline constexpr std::size_t kMaxDelaySteps = 255;
+// the longest steering dead time validate() accepts, s (kMaxDelaySteps at 1 kHz, with margin)
+inline constexpr double kMaxSteeringDeadTime = 0.25;
+
+// empty when every field is finite and physically valid, else the first problem,
+// starting with the field name, e.g. "mass must be > 0 kg (got -1)"
+std::string validate(const VehicleParams& p);
+
+// what the driver (the autonomy stack) asks for. Out-of-range values are limited;
+// non-finite ones are replaced by safe values (steering: hold, throttle 0, brake 1).
+struct DriverInput {
+  double steering_angle = 0.0;  // rad, road-wheel angle request, > 0 turns left
+  double throttle = 0.0;        // [0, 1], fraction of the maximum motor force cm1
+  double brake = 0.0;           // [0, 1], fraction of the maximum brake force
+};
+
+// the mutable state. A plain value type: copy it to fork a simulation.
+struct VehicleState {
+  // pose of the centre of gravity in the map frame
+  double x = 0.0;    // m
+  double y = 0.0;    // m
+  double yaw = 0.0;  // rad, wrapped to [-pi, pi)
+  // velocity of the CG in the body frame, and yaw rate
+  double vx = 0.0;   // m/s, forward
+  double vy = 0.0;   // m/s, left
+  double r = 0.0;    // rad/s, counter-clockwise
+  // actual actuator states, after dead time, limits and lags
+  double steering = 0.0;  // rad, road-wheel angle
+  double throttle = 0.0;  // [0, 1]
+  double brake = 0.0;     // [0, 1]
+  // longitudinal acceleration felt by the suspension (lagged ax) for the load transfer
+  double ax_load = 0.0;   // m/s^2
+  // mean over the last step (RK4-weighted): acceleration of the CG in the body
+  // frame (what an accelerometer at the CG measures on flat ground) and yaw acceleration
+  double ax = 0.0;        // m/s^2
+  double ay = 0.0;        // m/s^2
+  double yaw_accel = 0.0; // rad/s^2
+  // steering dead time: a ring buffer of past steering commands
+  std::array<double, kMaxDelaySteps + 1> steering_delay{};  // rad
+  std::size_t delay_head = 0;  // index of the slot the next command is written to
+};
+
+// the state at rest with the base frame (rear axle centre on the ground) at base_pose
+VehicleState initial_state(const VehicleParams& p, Pose2 base_pose);
+
+// one fixed step of length dt (s): RK4 over the whole state (rigid body and actuators)
+void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt);
+
+// lateral tyre force (N) at slip angle alpha (rad) and normal load fz (N); opposes the slip.
+// Linear in fz, so it serves one wheel or a whole axle.
+double tyre_lateral_force(const VehicleParams& p, double alpha, double fz);
+
+// weight of the dynamic model in the low-speed blend: clamp(0.5 (|v| - 1.5), 0, 1)
+double dynamic_weight(double speed);
+
+// below this |vx| (m/s) rolling resistance and brakes fade linearly to zero, so that a
+// car at rest stays exactly at rest; chosen from dt for RK4 stability (see vehicle.cc)
+double standstill_speed(const VehicleParams& p, double dt);
+
+// pose of the base frame (rear axle centre) in the map
+Pose2 base_pose(const VehicleParams& p, const VehicleState& s);
+// velocity of the base origin (rear axle centre), in the base (body) frame, m/s
+Vec2 base_velocity(const VehicleParams& p, const VehicleState& s);
+// acceleration of the CG in the body frame over the last step (x forward, y left), m/s^2
+Vec2 body_acceleration(const VehicleState& s);
+// speed of the CG, m/s
+double speed(const VehicleState& s);
+
+enum Wheel : std::size_t { kFrontLeft = 0, kFrontRight = 1, kRearLeft = 2, kRearRight = 3 };
+// contact patches in the map frame: FL, FR, RL, RR
+std::array<Vec2, 4> wheel_positions(const VehicleParams& p, const VehicleState& s);
+// wheel angular speeds, rad/s (> 0 rolling forward): the contact patch velocity along the
+// wheel heading over the rolling radius (no longitudinal slip model): FL, FR, RL, RR
+std::array<double, 4> wheel_speeds(const VehicleParams& p, const VehicleState& s);
+
+// the collision footprint: an axis-aligned rectangle in the base frame
+struct Footprint {
+  double x_min = 0.0;  // m, back (-rear_overhang)
+  double x_max = 0.0;  // m, front (lf + lr + front_overhang)
+  double y_min = 0.0;  // m, right (-body_width / 2)
+  double y_max = 0.0;  // m, left (body_width / 2)
+  // corners counter-clockwise from the back right: (x_min, y_min), (x_max, y_min), (x_max, y_max), (x_min, y_max)
+  std::array<Vec2, 4> corners() const {
+    return {Vec2{x_min, y_min}, Vec2{x_max, y_min}, Vec2{x_max, y_max}, Vec2{x_min, y_max}};
+  }
+};
+Footprint footprint(const VehicleParams& p);
+
+}  // namespace paddock::vehicle
