@@ -29,7 +29,7 @@ struct AutonomyModes {
 enum class Mission { Acceleration, Skidpad, Autocross, Trackdrive };
 
 struct MissionParams {
-  double stop_decel = 6.0;         // deceleration of the stop after the finish (m/s^2)
+  double stop_decel = 8.0;         // deceleration of the stop after the finish (m/s^2), the planner's braking limit
   double standstill_speed = 0.05;  // below this the car counts as stopped (m/s)
   double state_timeout = 0.2;      // a state estimate older than this triggers the safe stop (s)
 };

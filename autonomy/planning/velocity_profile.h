@@ -1,0 +1,118 @@
+#pragma once
+// the velocity profile: the forward-backward solver with a friction ellipse
+// (paper section "Planning", after TUM trajectory_planning_helpers'
+// calc_vel_profile v0.80, written anew here).
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace paddock::planning {
+
+// the car's g-g limits and longitudinal model for the profile. The defaults
+// are the AMZ "gotthard" car (m = 190 kg, tyre mu ~1.6, aero drag
+// F = 0.7 v^2 N, motors 5000 N at the wheels), planned a little inside its
+// limits so that the controller keeps a margin.
+struct VelocityProfileParams {
+  // the limits the stack plans with, not the tyres' own: the gotthard car's
+  // tyres carry mu g = 1.6 * 9.81 = 15.7 m/s^2 (more with downforce), and a
+  // driverless stack keeps about half of that in reserve for tracking,
+  // localisation and perception errors, as the paper's car did (41 s laps on
+  // FSG 2023). With these limits the car laps FSG 2023 in about 35 s.
+  // longitudinal acceleration limit (m/s^2): 0.8 g
+  double ax_max = 8.0;
+  // lateral acceleration limit (m/s^2): 0.8 g, about half the tyres' grip
+  double ay_max = 8.0;
+  // deceleration limit (m/s^2, positive): 0.8 g
+  double ax_brake_max = 8.0;
+  // exponent p of the g-g shape (ax/ax_max)^p + (ay/ay_max)^p <= 1:
+  // 2 is the friction ellipse, 1 a diamond (conservative); >= 1 (the
+  // reference recommends [1, 2]).
+  double exponent = 2.0;
+  // machine (motor) acceleration limit without drag (m/s^2), constant in
+  // speed: 5000 N / 190 kg = 26.3 m/s^2 is more than the tyres can transmit,
+  // so it is capped at the traction limit mu g = 1.6 * 9.81 = 15.7 m/s^2;
+  // with ax_max = 8 the planned limit is what shapes the launch.
+  double ax_machine = 15.7;
+  // vehicle mass (kg), used only to turn drag force into deceleration.
+  double mass = 190.0;
+  // aerodynamic drag F = c_d v^2 (N s^2/m^2): it slows the car when
+  // accelerating and helps it when braking.
+  double drag_coefficient = 0.7;
+  // top speed (m/s): 72 km/h, about what FS trackdrive straights allow.
+  double v_max = 20.0;
+  // the paper's "reduced acceleration limits in turns" (dimensionless, in
+  // [0, 1]; 1 = off). The tyre limits ax_max and ax_brake_max are scaled by
+  //   f = 1 - (1 - turn_accel_scale) * min(1, ay / ay_max),   ay = v^2 |kappa|,
+  // before the friction ellipse is applied: on a straight f = 1, and the more
+  // of the lateral grip a turn uses, the less of the longitudinal limit is
+  // assumed available (a more conservative g-g shape in combined slip, where
+  // real tyres and a tracking controller fall short of the ideal ellipse).
+  // Default 0.5: in a turn at the lateral limit, half the straight-line
+  // acceleration and braking is planned.
+  double turn_accel_scale = 0.5;
+};
+
+// a reason when the parameters cannot be used, or nothing when they can
+std::optional<std::string> validate(const VelocityProfileParams& p);
+
+// speeds along a path; `reason` says why it failed (empty when ok)
+struct VelocityProfile {
+  std::vector<double> speed;  // m/s, one per input point (empty on failure)
+  std::string reason;
+
+  bool ok() const { return reason.empty(); }
+};
+
+// the fastest speeds along a path within the car's limits.
+//
+// The discretisation is the reference's: corner speeds sqrt(ay_max/|kappa|)
+// capped at v_max; a forward pass v_i+1^2 = v_i^2 + 2 a ds with a taken at
+// point i (tyre limit from the g-g shape at v_i, capped by the machine, minus
+// drag c_d v_i^2 / m); a backward pass the same with the braking limit plus
+// drag, evaluated at the later point and once more at the earlier one with
+// the speed that gives, keeping the smaller. It reproduces the reference's
+// figures (ORACLES A-D3) and its profiles wherever the reference is right;
+// it differs on purpose where the reference is not:
+//  - closed paths: the reference keeps the lap of its backward pass that had
+//    no run-in, so a lap starting inside a braking zone loses that braking
+//    zone; here both passes go round until the wrap is consistent, and the
+//    profile does not depend on where the lap starts;
+//  - closed paths with uneven steps: the reference's backward pass takes
+//    the length of the step after each point instead of the one before;
+//  - the reference only sweeps forward from points where its first guess
+//    rises and stops a sweep once it passes v_max, so drag never slows a
+//    stretch that starts level (a constant corner after a v_max straight, or
+//    a closed straight); here every step is swept.
+//
+//   curvature        signed curvature at each point (1/m); 0 = straight
+//   segment_lengths  distance from point i to point i+1 (m, > 0); a closed
+//                    path has one per point (the last closes the loop to
+//                    point 0), an open path one fewer than points
+//   closed           the path is a lap: solved round the loop so that the
+//                    speed at the end of the lap leads into its start
+//   v_start, v_end   (open paths only; ignored when closed) upper bounds of
+//                    the speed at the first and last point (m/s, negative is
+//                    taken as 0); nothing = free
+// Errors (empty input, sizes that do not match, NaN or infinite values,
+// non-positive segment lengths, bad parameters) come back in `reason`.
+VelocityProfile solve_velocity_profile(const std::vector<double>& curvature,
+                                       const std::vector<double>& segment_lengths, bool closed,
+                                       const VelocityProfileParams& params,
+                                       std::optional<double> v_start = std::nullopt,
+                                       std::optional<double> v_end = std::nullopt);
+
+// time to drive the profile (s), constant acceleration along each segment:
+// t = sum 2 ds_i / (v_i + v_i+1), including the closing segment when closed
+// (segment_lengths then has one entry per point). Infinite when the car
+// stands still over a segment of non-zero length; NaN for inconsistent sizes.
+double profile_time(const std::vector<double>& speed, const std::vector<double>& segment_lengths,
+                    bool closed);
+
+// the longitudinal acceleration available at speed v on curvature kappa
+// (m/s^2), drag included, as the solver uses it: forward (accelerating,
+// >= -drag) or backward (the deceleration magnitude available to brake).
+// Exposed for tests that check the profile against the limits.
+double available_acceleration(double v, double kappa, const VelocityProfileParams& p);
+double available_deceleration(double v, double kappa, const VelocityProfileParams& p);
+
+}  // namespace paddock::planning
