@@ -1,0 +1,149 @@
+// the stack behind a scripted HAL: the AS state machine, the safe stop, the
+// finish-line count and the stop after it, on a synthetic circle
+#include "autonomy/stack/stack.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <deque>
+#include <vector>
+
+namespace paddock::stack {
+namespace {
+
+// a HAL whose messages the test posts and whose commands it reads
+class ScriptedHal final : public hal::Hal {
+ public:
+  std::deque<hal::SensorMessage> inbox;
+  std::vector<hal::ActuatorCommand> sent;
+  std::optional<hal::SensorMessage> receive() override {
+    if (inbox.empty()) return std::nullopt;
+    auto m = inbox.front();
+    inbox.pop_front();
+    return m;
+  }
+  void send(const hal::ActuatorCommand& c) override { sent.push_back(c); }
+};
+
+std::vector<Vec2> circle(double r, int n) {
+  std::vector<Vec2> pts;
+  for (int i = 0; i < n; ++i) pts.push_back(Vec2{0.0, r} + unit_from_angle(-kPi / 2 + 2 * kPi * i / n) * r);
+  return pts;
+}
+
+MissionSpec circle_mission(int crossings) {
+  MissionSpec m;
+  m.mission = Mission::Trackdrive;
+  m.oracle_path = circle(20.0, 72);  // counter-clockwise from (0, 0) heading +x
+  m.oracle_closed = true;
+  m.finish_line = Segment{{5.0, 3.0}, {5.0, -3.0}};
+  m.finish_crossings = crossings;
+  return m;
+}
+
+hal::StateEstimate state_at(TimeNs t, Vec2 p, double yaw, double v) {
+  return hal::StateEstimate{t, Pose2{p.x, p.y, yaw}, v, 0.0, 0.0};
+}
+
+TEST(Stack, WaitsInReadyWithBrakesOnUntilGo) {
+  Stack s(StackParams{}, circle_mission(2));
+  ScriptedHal hal;
+  s.tick(0, hal);  // no state yet: off
+  EXPECT_EQ(hal.sent.back().as_state, hal::AsState::Off);
+  for (int k = 1; k < 50; ++k) {
+    hal.inbox.push_back(state_at(k * 10'000'000, {0, 0}, 0.0, 0.0));
+    s.tick(k * 10'000'000, hal);
+    EXPECT_EQ(hal.sent.back().as_state, hal::AsState::Ready);
+    EXPECT_EQ(hal.sent.back().brake, 1.0);
+    EXPECT_EQ(hal.sent.back().throttle, 0.0);
+  }
+  hal.inbox.push_back(state_at(500'000'000, {0, 0}, 0.0, 0.0));
+  hal.inbox.push_back(hal::ResSignal{500'000'000, true, false});
+  s.tick(500'000'000, hal);
+  EXPECT_EQ(hal.sent.back().as_state, hal::AsState::Driving);
+  EXPECT_GT(hal.sent.back().throttle, 0.0);  // launches
+  EXPECT_EQ(hal.sent.back().brake, 0.0);
+}
+
+TEST(Stack, EmergencyFromAnyState) {
+  Stack s(StackParams{}, circle_mission(2));
+  ScriptedHal hal;
+  hal.inbox.push_back(state_at(0, {0, 0}, 0.0, 0.0));
+  hal.inbox.push_back(hal::ResSignal{0, true, false});
+  s.tick(0, hal);
+  ASSERT_EQ(hal.sent.back().as_state, hal::AsState::Driving);
+  hal.inbox.push_back(hal::ResSignal{10'000'000, false, true});
+  s.tick(10'000'000, hal);
+  EXPECT_EQ(hal.sent.back().as_state, hal::AsState::Emergency);
+  EXPECT_EQ(hal.sent.back().brake, 1.0);
+}
+
+TEST(Stack, StaleStateGivesTheSafeStopAndCountsIt) {
+  Stack s(StackParams{}, circle_mission(2));
+  ScriptedHal hal;
+  hal.inbox.push_back(state_at(0, {0, 0}, 0.0, 5.0));
+  hal.inbox.push_back(hal::ResSignal{0, true, false});
+  s.tick(0, hal);
+  // no estimate for 0.5 s (the timeout is 0.2 s)
+  s.tick(500'000'000, hal);
+  EXPECT_EQ(hal.sent.back().brake, 1.0);
+  EXPECT_EQ(hal.sent.back().steering_angle, 0.0);
+  EXPECT_EQ(s.telemetry().fallbacks, 1);
+  EXPECT_NE(s.telemetry().last_fault.find("stale"), std::string::npos);
+}
+
+TEST(Stack, BadPlanInputLeavesTheCarParkedWithAReason) {
+  MissionSpec m = circle_mission(2);
+  m.oracle_path = {{0.0, 0.0}};  // one point: no path
+  Stack s(StackParams{}, m);
+  ScriptedHal hal;
+  hal.inbox.push_back(state_at(0, {0, 0}, 0.0, 0.0));
+  hal.inbox.push_back(hal::ResSignal{0, true, false});
+  s.tick(0, hal);
+  EXPECT_EQ(hal.sent.back().as_state, hal::AsState::Off);
+  EXPECT_EQ(hal.sent.back().brake, 1.0);
+  EXPECT_NE(s.telemetry().last_fault.find("planning"), std::string::npos);
+}
+
+// a kinematic car drives the stack's commands around the circle: it must count
+// its crossings of the finish line, brake after the last one, stop, and finish
+TEST(Stack, CountsFinishCrossingsThenStopsAndFinishes) {
+  StackParams p;
+  Stack s(p, circle_mission(3));  // start line, then two laps
+  ScriptedHal hal;
+  double x = -2.0, y = 0.0, yaw = 0.0, v = 0.0, delta = 0.0;
+  const double L = p.vehicle.wheelbase;
+  int stop_crossing_cycle = -1;
+  double dist_after_stop_start = 0.0;
+  for (int k = 0; k < 100 * 120; ++k) {
+    const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
+    hal.inbox.push_back(state_at(t, {x, y}, yaw, v));
+    if (k == 10) hal.inbox.push_back(hal::ResSignal{t, true, false});
+    s.tick(t, hal);
+    const auto& c = hal.sent.back();
+    if (c.as_state == hal::AsState::Finished) break;
+    if (s.telemetry().stopping && stop_crossing_cycle < 0) stop_crossing_cycle = k;
+    // a kinematic bicycle at the rear axle, 10 ms steps; the pedals as accelerations
+    delta = c.steering_angle;
+    const double a = 8.0 * c.throttle - 10.0 * c.brake;
+    for (int i = 0; i < 10; ++i) {
+      const double dt = 1e-3;
+      x += v * std::cos(yaw) * dt;
+      y += v * std::sin(yaw) * dt;
+      yaw += v * std::tan(delta) / L * dt;
+      if (stop_crossing_cycle >= 0) dist_after_stop_start += v * dt;
+      v = std::max(0.0, v + a * dt);
+    }
+  }
+  EXPECT_EQ(s.telemetry().finish_crossings, 3);
+  EXPECT_TRUE(s.telemetry().stopping);
+  EXPECT_EQ(hal.sent.back().as_state, hal::AsState::Finished);
+  EXPECT_EQ(hal.sent.back().brake, 1.0);
+  // it stops soon after the line: from at most the planned 8 m/s^2 stop
+  EXPECT_GT(stop_crossing_cycle, 0);
+  EXPECT_LT(dist_after_stop_start, 40.0);
+  EXPECT_EQ(s.telemetry().fallbacks, 0);
+}
+
+}  // namespace
+}  // namespace paddock::stack
