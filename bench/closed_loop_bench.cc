@@ -16,7 +16,7 @@ using namespace paddock;
 void BM_DefaultScenario(benchmark::State& state) {
   const runner::Scenario sc =
       runner::load_scenario(std::string(PADDOCK_SOURCE_DIR) + "/scenarios/fsg_2023_trackdrive.ini");
-  const world::TrackModel track = world::build_track(world::load_track_file(sc.track_path));
+  const world::TrackModel track = world::build_track(runner::load_track_file(sc.track_path));
   double sim_seconds = 0.0;
   bool finished = true;
   for (auto _ : state) {

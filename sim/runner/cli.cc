@@ -24,7 +24,7 @@ const char* kUsage =
 
 // track files: the only place the program reads them
 world::TrackModel load_track(const std::string& path, std::vector<std::string>* warnings) {
-  world::TrackFile file = world::load_track_file(path);
+  world::TrackFile file = load_track_file(path);
   if (warnings) *warnings = file.warnings;
   return world::build_track(file);
 }
@@ -73,7 +73,7 @@ int cmd_check_track(const std::vector<std::string>& args) {
   int bad = 0;
   for (const auto& path : args) {
     try {
-      const world::TrackFile file = world::load_track_file(path);
+      const world::TrackFile file = load_track_file(path);
       const world::TrackModel track = world::build_track(file);
       std::cout << world::check_track_report(track, file) << "\n";
     } catch (const std::exception& e) {

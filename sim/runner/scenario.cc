@@ -406,6 +406,10 @@ std::string resolved_ini(const Scenario& s) {
 
 namespace paddock::runner {
 
+world::TrackFile load_track_file(const std::string& path) {
+  return world::parse_track(read_file(path), path);
+}
+
 stack::StackParams stack_params(const Scenario& s) {
   stack::StackParams p;
   p.modes = s.autonomy;

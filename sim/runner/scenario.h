@@ -11,6 +11,7 @@
 #include "sim/events/event.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
+#include "sim/world/track.h"
 #include "sim/runner/schema.h"
 
 namespace paddock::runner {
@@ -70,6 +71,10 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
 // the resolved scenario as INI text: every key, defaults included, in SI units,
 // loadable again to the same Scenario
 std::string resolved_ini(const Scenario& s);
+
+// reads and parses a track file; throws UserError "path: cannot open ..." or
+// world::TrackError "path:line: ..."
+world::TrackFile load_track_file(const std::string& path);
 
 // the stack's parameters as compiled from the scenario (the vehicle knowledge
 // comes from the same [vehicle] section as the simulated car)

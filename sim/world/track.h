@@ -3,8 +3,8 @@
 // order its cones into boundaries and derive the centreline, widths, gates,
 // start pose and the on-track region the events module asks at 100 Hz.
 //
-// Only load_track_file() touches the file system; everything else works on
-// text and values, so a scenario compiler can feed it from anywhere.
+// Nothing here touches the file system: it works on text and values, and the
+// program's edge (sim/runner) reads the files.
 #include <cstddef>
 #include <optional>
 #include <stdexcept>
@@ -48,9 +48,6 @@ struct TrackFile {
 
 // parse the text of a track file; `source` names it in messages. Throws TrackError.
 TrackFile parse_track(std::string_view text, const std::string& source);
-
-// read `path` and parse it (the only file read of this module). Throws TrackError.
-TrackFile load_track_file(const std::string& path);
 
 enum class TrackKind { Circuit, Acceleration, Skidpad };
 

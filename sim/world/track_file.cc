@@ -3,7 +3,6 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <string_view>
@@ -197,15 +196,6 @@ TrackFile parse_track(std::string_view text, const std::string& source) {
   }
   find_doubles(f);
   return f;
-}
-
-TrackFile load_track_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw TrackError(path + ": cannot open the track file (missing or unreadable)");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) throw TrackError(path + ": cannot read the track file");
-  return parse_track(ss.str(), path);
 }
 
 }  // namespace paddock::world

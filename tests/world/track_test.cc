@@ -21,6 +21,16 @@
 namespace paddock::world {
 namespace {
 
+// the file's text through parse_track, as the runner feeds it
+TrackFile load_track_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw TrackError(path + ": cannot open");
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parse_track(ss.str(), path);
+}
+
+
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
@@ -592,16 +602,6 @@ TEST(BadFiles, MissingHeaderRow) {
   EXPECT_THAT(e, StartsWith(kBad + "/missing_header.csv:2: "));
   EXPECT_THAT(e, HasSubstr("missing header row"));
   EXPECT_THAT(e, HasSubstr("'tag,x,y'"));
-}
-
-TEST(BadFiles, MissingFileNamesThePath) {
-  const std::string path = kBad + "/no_such_track.csv";
-  try {
-    load_track_file(path);
-    FAIL() << "no error";
-  } catch (const TrackError& e) {
-    EXPECT_THAT(std::string(e.what()), StartsWith(path + ": cannot open"));
-  }
 }
 
 TEST(Parse, HeaderLinesCommentsAndCrlf) {
