@@ -1,10 +1,21 @@
 #include "sim/events/event.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "autonomy/common/polyline.h"
 
 namespace paddock::events {
+namespace {
+
+// "5 s", "0.25 s": a duration for messages
+std::string seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g s", s);
+  return buf;
+}
+
+}  // namespace
 
 const char* to_string(EventKind k) {
   switch (k) {
@@ -96,6 +107,9 @@ void Event::on_sample(const CarSample& s) {
   last_doo_total_ = s.doo_total;
   result_.doo = s.doo_total;
 
+  if (s.as_emergency) return finish_run(false, "the car went to AS Emergency", s.t);
+  if (!go_time_) return;
+
   // off course: all four wheels outside the boundaries; one excursion counts once
   bool all_off = true;
   for (const Vec2& w : s.wheels) all_off = all_off && !track_->on_track(w);
@@ -108,11 +122,9 @@ void Event::on_sample(const CarSample& s) {
     off_track_ = false;
   }
 
-  if (s.as_emergency) return finish_run(false, "the car went to AS Emergency", s.t);
-  if (!go_time_) return;
   if (off_track_ && s.t - off_track_since_ > params_.off_track_dnf_time) {
     return finish_run(false, "left the track for good (all wheels off for longer than " +
-                                 std::to_string(params_.off_track_dnf_time) + " s)", s.t);
+                                 seconds(params_.off_track_dnf_time) + ")", s.t);
   }
   const bool at_rest = s.speed < params_.standstill_speed;
   if (!at_rest) at_rest_since_.reset();
@@ -127,7 +139,7 @@ void Event::on_sample(const CarSample& s) {
     }
     if (s.t - finish_cross_time_ > params_.stop_time) {
       return finish_run(false, "did not come to a stop with AS Finished within " +
-                                   std::to_string(params_.stop_time) + " s of the finish", s.t);
+                                   seconds(params_.stop_time) + " of the finish", s.t);
     }
     return;
   }

@@ -118,7 +118,6 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   bool go_sent = false;
 
   RunResult res;
-  res.log.reserve(static_cast<std::size_t>((sc.event.timeout + sc.scenario.go_time + 60.0) * sc.sim.log_rate));
   auto nose_of = [&](const Pose2& base) { return base.transform({footprint.x_max, 0.0}); };
 
   for (long k = 0;; ++k) {
