@@ -136,68 +136,6 @@ std::string validate(const VehicleParams& p) {
 // tyre and blend
 // ---------------------------------------------------------------------------
 
-namespace {
-
-// the hot path spends most of its time in atan and sin (the tyre curve and the slip
-// angles: 24 atan and 8 sin per step), so it uses these two polynomial versions,
-// inlined so that the front and rear tyre overlap. Both are accurate to better than
-// 1e-13, far below anything physical; the tyre test checks them against libm.
-
-// atan(x) = t + t^3 P(t^2) after reducing |x| to |t| <= tan(pi/8):
-//   atan(a) = pi/4 + atan((a - 1) / (a + 1))  for tan(pi/8) < a <= tan(3 pi/8),
-//   atan(a) = pi/2 + atan(-1 / a)             above.
-// P: Chebyshev fit (mpmath chebyfit, degree 7 in t^2) of (atan(t) - t) / t^3 on
-// [0, tan^2(pi/8)]; its error on atan is below 5e-14. Evaluated with Estrin's scheme
-// (a shallower dependency chain than Horner's).
-inline double fast_atan(double x) {
-  constexpr double kTanPi8 = 0.41421356237309504880;   // tan(pi/8)
-  constexpr double kTan3Pi8 = 2.41421356237309504880;  // tan(3 pi/8)
-  const double a = std::abs(x);
-  double t, base;
-  if (a <= kTanPi8) {
-    t = a;
-    base = 0.0;
-  } else if (a <= kTan3Pi8) {
-    t = (a - 1.0) / (a + 1.0);
-    base = 0.25 * kPi;
-  } else {
-    t = -1.0 / a;  // inf -> -0, NaN stays NaN
-    base = 0.5 * kPi;
-  }
-  const double z = t * t;
-  const double z2 = z * z;
-  const double z4 = z2 * z2;
-  const double p01 = -0.33333333333266199 + 0.19999999949854793 * z;
-  const double p23 = -0.142857081103604 + 0.11110819716745676 * z;
-  const double p45 = -0.090841018953464295 + 0.076048000460782915 * z;
-  const double p67 = -0.060273074609466753 + 0.032956795418701366 * z;
-  const double p = (p01 + z2 * p23) + z4 * (p45 + z2 * p67);
-  return std::copysign(base + (t + t * z * p), x);
-}
-
-// sin(x) = u + u^3 Q(u^2) for |x| <= pi, with u = |x| folded into [0, pi/2] by
-// sin(a) = sin(pi - a). Q: Chebyshev fit (degree 6 in u^2) of (sin(u) - u) / u^3 on
-// [0, (pi/2)^2]; its error on sin is below 1e-15 (plus the rounding of pi - a).
-// Outside [-pi, pi] (never reached by the tyre: |C atan(.)| < pi for C < 2) it defers to libm.
-inline double fast_sin(double x) {
-  const double a = std::abs(x);
-  if (!(a <= kPi)) return std::sin(x);
-  const double u = a > 0.5 * kPi ? kPi - a : a;
-  const double z = u * u;
-  const double z2 = z * z;
-  const double z4 = z2 * z2;
-  const double q01 = -0.16666666666666648 + 0.0083333333333259327 * z;
-  const double q23 = -0.00019841269836469025 + 2.7557318055685784e-6 * z;
-  const double q45 = -2.5051972921545552e-8 + 1.6050972244135635e-10 * z;
-  const double q = (q01 + z2 * q23) + z4 * (q45 + z2 * -7.4080548895426099e-13);
-  return std::copysign(u + u * z * q, x);
-}
-
-// atan2(y, x) for the slip angles: atan(y / x) while moving forward, libm otherwise
-inline double slip_atan2(double y, double x) { return x > 0.0 ? fast_atan(y / x) : std::atan2(y, x); }
-
-}  // namespace
-
 // Pacejka magic formula, lateral, without shifts:
 //   mu_y(a) = D sin(C atan(B a - E (B a - atan(B a))))
 //   Fy      = -mu_y(a) Fz      (the force opposes the slip angle)
@@ -206,7 +144,7 @@ inline double slip_atan2(double y, double x) { return x > 0.0 ? fast_atan(y / x)
 namespace {
 inline double tyre_mu(const VehicleParams& p, double alpha) {
   const double ba = p.tyre_b * alpha;
-  return p.tyre_d * fast_sin(p.tyre_c * fast_atan(ba - p.tyre_e * (ba - fast_atan(ba))));
+  return p.tyre_d * std::sin(p.tyre_c * std::atan(ba - p.tyre_e * (ba - std::atan(ba))));
 }
 }  // namespace
 
@@ -300,25 +238,6 @@ constexpr double kKinematicTimeConstant = 0.01;
 // smallest regularisation speed of the standstill forces, m/s (see standstill_speed)
 constexpr double kMinStandstillSpeed = 0.02;
 
-struct SinCos {
-  double s, c;
-};
-
-// sin and cos of a, given them at a nearby a0: rotate (cos a0, sin a0) by d = a - a0
-// with Taylor series, d - d^3/6 + d^5/120 and 1 - d^2/2 + d^4/24 - d^6/720, whose
-// truncation errors (d^7/5040, d^8/40320) are below 1e-17 for |d| <= 0.01. Within one
-// step yaw moves by r dt (< 0.01 rad below 10 rad/s at 1 kHz) and the steering by at
-// most steering_rate_max dt, so RK4's stages need no sin/cos call; larger moves fall
-// back to the library.
-inline SinCos sincos_near(double a, double a0, SinCos at_a0) {
-  const double d = a - a0;
-  if (!(std::abs(d) <= 0.01)) return {std::sin(a), std::cos(a)};
-  const double d2 = d * d;
-  const double sd = d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0));
-  const double cd = 1.0 - d2 / 2.0 * (1.0 - d2 / 12.0 * (1.0 - d2 / 30.0));
-  return {at_a0.s * cd + at_a0.c * sd, at_a0.c * cd - at_a0.s * sd};
-}
-
 // everything constant over one step
 struct Model {
   const VehicleParams* p;
@@ -329,9 +248,6 @@ struct Model {
   double inv_tau_steer, inv_tau_thr, inv_tau_brk, inv_tau_pitch;  // 1/s, 0 = instantaneous (set outside RK4)
   // commands after dead time and limits
   double steer_cmd, thr_cmd, brk_cmd;
-  // yaw and steering at the start of the step, with their sines and cosines
-  double yaw0, steer0;
-  SinCos yaw0_sc, steer0_sc;
 };
 
 // standstill regularisation: sat(vx) = clamp(vx / v_reg, -1, 1) replaces sign(vx) in
@@ -393,8 +309,8 @@ Deriv derivative(const Model& m, const X& s) {
   // lateral tyre forces, only where the dynamic model has weight (no slip angle at rest)
   double fy_f = 0.0, fy_r = 0.0;
   if (lambda > 0.0) {
-    const double alpha_f = slip_atan2(s.vy + p.lf * s.r, s.vx) - s.steer;
-    const double alpha_r = slip_atan2(s.vy - p.lr * s.r, s.vx);
+    const double alpha_f = std::atan2(s.vy + p.lf * s.r, s.vx) - s.steer;
+    const double alpha_r = std::atan2(s.vy - p.lr * s.r, s.vx);
     fy_f = -tyre_mu(p, alpha_f) * fz_f;
     fy_r = -tyre_mu(p, alpha_r) * fz_r;
   }
@@ -407,9 +323,8 @@ Deriv derivative(const Model& m, const X& s) {
   const double fx_f = std::clamp(fx_f_demand, -fx_lim_f, fx_lim_f);
   const double fx_r = std::clamp(fx_r_demand, -fx_lim_r, fx_lim_r);
 
-  const SinCos steer_sc = sincos_near(s.steer, m.steer0, m.steer0_sc);
-  const double sd = steer_sc.s;
-  const double cd = steer_sc.c;
+  const double sd = std::sin(s.steer);
+  const double cd = std::cos(s.steer);
 
   // kinematic and dynamic velocity derivatives, blended
   double vx_dot = 0.0, vy_dot = 0.0, r_dot = 0.0;
@@ -439,9 +354,8 @@ Deriv derivative(const Model& m, const X& s) {
   d.ax_load = (out.ax - s.ax_load) * m.inv_tau_pitch;
 
   // pose: rotate the body velocity into the map
-  const SinCos yaw_sc = sincos_near(s.yaw, m.yaw0, m.yaw0_sc);
-  const double cy = yaw_sc.c;
-  const double sy = yaw_sc.s;
+  const double cy = std::cos(s.yaw);
+  const double sy = std::sin(s.yaw);
   d.px = s.vx * cy - s.vy * sy;
   d.py = s.vx * sy + s.vy * cy;
   d.yaw = s.r;
@@ -518,10 +432,6 @@ void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double
 
   // classic RK4
   const X x0{s.x, s.y, s.yaw, s.vx, s.vy, s.r, s.steering, s.throttle, s.brake, s.ax_load};
-  m.yaw0 = x0.yaw;
-  m.yaw0_sc = {std::sin(x0.yaw), std::cos(x0.yaw)};
-  m.steer0 = x0.steer;
-  m.steer0_sc = {std::sin(x0.steer), std::cos(x0.steer)};
   const double h = 0.5 * dt;
   const Deriv k1 = derivative(m, x0);
   const Deriv k2 = derivative(m, axpy(x0, h, k1.d));

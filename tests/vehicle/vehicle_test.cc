@@ -166,22 +166,6 @@ TEST(Tyre, MatchesFssimOracle) {
   EXPECT_EQ(tyre_lateral_force(p, 0.0, fz), 0.0);
 }
 
-TEST(Tyre, MatchesTheTextbookFormulaEverywhere) {
-  // the model evaluates the curve with its own polynomial atan and sin; compare with
-  // the formula written with libm over slip angles up to +-pi/2 (all reduction branches)
-  const VehicleParams& p = defaults();
-  const double fz = 1000.0;
-  double worst = 0.0;
-  for (int i = -20000; i <= 20000; ++i) {
-    const double a = 0.5 * kPi * i / 20000.0;
-    const double ba = p.tyre_b * a;
-    const double reference =
-        -p.tyre_d * fz * std::sin(p.tyre_c * std::atan(ba - p.tyre_e * (ba - std::atan(ba))));
-    worst = std::max(worst, std::abs(tyre_lateral_force(p, a, fz) - reference));
-  }
-  EXPECT_LT(worst, 1e-12 * p.tyre_d * fz);
-}
-
 TEST(Tyre, DynamicWeightIsTheFssimBlend) {
   EXPECT_EQ(dynamic_weight(0.0), 0.0);
   EXPECT_EQ(dynamic_weight(1.5), 0.0);
