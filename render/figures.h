@@ -43,6 +43,9 @@ struct AxesFrame {
   Box plot;                    // the plotting area inside the axes lines
   double x_min = 0.0, x_max = 1.0, y_min = 0.0, y_max = 1.0;  // data range shown
   // the pixel centre (x right, y down) of a data point
+  // (continuous pixel coordinates: pixel (i, j) covers [i, i + 1) x [j, j + 1),
+  // so the pixel under a point is (floor(x), floor(y)); the plot box's edges are
+  // the range's ends)
   Vec2 to_pixel(Vec2 data) const;
 };
 
@@ -51,9 +54,13 @@ struct AxesFrame {
 struct Figure {
   Image image;
   std::vector<AxesFrame> axes;       // in drawing order (the map: one; controller data: one per panel)
+                                     // data units: the map in m; the controller panels t [s] and deg,
+                                     // m/s, m, deg; the lap chart lap number (lap k's bar centred on
+                                     // x = k) and s; the heat map cell indices (cell (i, j) centred on (i, j))
   std::map<std::string, Box> boxes;  // named parts: "title", "colorbar" (the colour strip itself),
                                      // "colorbar_label", "legend", "x_label", "y_label"
-                                     // (the controller figure: "y_label_0", "y_label_1", ...)
+                                     // (the controller figure: "y_label_0", "y_label_1", ...,
+                                     // "legend_0" and "legend_1" for its two-series panels)
 };
 
 // size and resolution; the font is the bytes of a TrueType file read by the caller
@@ -63,6 +70,7 @@ struct FigureStyle {
   double dpi = 150.0;       // px per inch: text and line sizes are given in points (1/72 in)
   const std::vector<std::uint8_t>* font = nullptr;  // required; not owned
   Rgba background{255, 255, 255, 255};
+  int supersample = 3;      // anti-aliasing: drawn at this many times the size and box-filtered down (1..4)
 };
 
 // ---- the track map (the paper's "planned path" figure) ----
@@ -92,12 +100,17 @@ struct TrackMapData {
   std::optional<Pose2> start;                // start pose (an arrow)
   std::vector<Vec2> trajectory;              // the driven path ...
   std::vector<double> speed;                 // ... coloured by speed (m/s), same size; a colour bar
+                                             // over [min, max] ([v - 0.5, v + 0.5] for one speed v);
+                                             // empty: one colour, no colour bar; NaN: a gap
   std::vector<MapLayer> layers;              // optional layers
   std::vector<Cone> estimated_cones;         // optional: a cone map estimated by SLAM (hollow markers)
 };
 
-// equal-aspect axes in metres around everything given
+// equal-aspect axes in metres around everything given; throws RenderError for a
+// bad style (no font, bad size) or speeds not matching the trajectory
 Figure draw_track_map(const TrackMapData& data, const FigureStyle& style);
+// the map's fill colour of a cone type (blue, yellow, small orange, big orange, unknown: grey)
+Rgba cone_color(ConeColor color);
 
 // ---- the controller data (the paper's "controller data" figure) ----
 
@@ -114,7 +127,8 @@ struct ControllerData {
 };
 
 // four stacked panels sharing the time axis: steering commanded vs actual,
-// speed reference vs actual, lateral error, heading error
+// speed reference vs actual, lateral error, heading error. A series is left out
+// when empty; one of another size than t is a RenderError; NaN: a gap
 Figure draw_controller_data(const ControllerData& data, const FigureStyle& style);
 
 // ---- the lap chart ----
@@ -141,6 +155,8 @@ struct HeatmapData {
   std::vector<double> values;  // y.size() * x.size(), row by row (y[0] first); NaN: no value (drawn hatched grey)
 };
 
+// one cell per (x, y) coloured by viridis over the finite values' range (one
+// value v: [v - 0.5, v + 0.5]); values.size() != x.size() * y.size() is a RenderError
 Figure draw_heatmap(const HeatmapData& data, const FigureStyle& style);
 
 // ---- colour maps and PNG ----

@@ -1,9 +1,11 @@
 #include "sim/runner/cli.h"
 
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
 #include "sim/runner/files.h"
+#include "sim/runner/plots.h"
 #include "sim/runner/report.h"
 #include "sim/runner/scenario.h"
 #include "sim/runner/simulation.h"
@@ -15,10 +17,17 @@ namespace {
 const char* kUsage =
     "usage:\n"
     "  paddock run SCENARIO.ini [--set section.key=value]... [--out DIR] [--json] [--quiet]\n"
+    "              [--plots [PLOT OPTIONS]]\n"
     "      runs a scenario headless and prints the result; writes DIR/summary.json,\n"
     "      DIR/scenario.ini (resolved, defaults included) and DIR/log.csv\n"
     "      (DIR defaults to runs/<scenario name>). --json prints the summary as JSON;\n"
-    "      --quiet prints only failed expectations. Exit 3 when [expect] fails.\n"
+    "      --quiet prints only failed expectations; --plots also draws the figures.\n"
+    "      Exit 3 when [expect] fails.\n"
+    "  paddock plot RUN_DIR [PLOT OPTIONS]\n"
+    "      draws DIR/map.png, DIR/controller.png and DIR/laps.png from a finished\n"
+    "      run's scenario.ini, log.csv and summary.json\n"
+    "  plot options: --map-size N (px, default 1600), --chart-size WxH (default\n"
+    "      1600x1200), --dpi D (default 150: text and lines are sized in points)\n"
     "  paddock check-track FILE...\n"
     "      loads, validates and describes track CSV files\n";
 
@@ -29,17 +38,49 @@ world::TrackModel load_track(const std::string& path, std::vector<std::string>* 
   return world::build_track(file);
 }
 
+// a whole number in [lo, hi] from an option's value
+int option_int(const std::string& flag, const std::string& v, int lo, int hi) {
+  char* end = nullptr;
+  const long x = std::strtol(v.c_str(), &end, 10);
+  if (v.empty() || *end != '\0' || x < lo || x > hi) {
+    throw UserError(flag + " " + v + ": expected a whole number from " + std::to_string(lo) + " to " + std::to_string(hi));
+  }
+  return static_cast<int>(x);
+}
+
+// takes a plot option at args[i] (and its value); false when args[i] is not one
+bool plot_option(const std::vector<std::string>& args, std::size_t& i, PlotOptions& o) {
+  const std::string& a = args[i];
+  if (a != "--map-size" && a != "--chart-size" && a != "--dpi") return false;
+  if (i + 1 >= args.size()) throw UserError(a + " needs a value");
+  const std::string v = args[++i];
+  if (a == "--map-size") {
+    o.map_size = option_int(a, v, 200, 10000);
+  } else if (a == "--chart-size") {
+    const auto x = v.find('x');
+    if (x == std::string::npos) throw UserError(a + " " + v + ": expected WIDTHxHEIGHT, e.g. 1600x1200");
+    o.chart_width = option_int(a, v.substr(0, x), 200, 10000);
+    o.chart_height = option_int(a, v.substr(x + 1), 200, 10000);
+  } else {
+    o.dpi = option_int(a, v, 30, 1200);
+  }
+  return true;
+}
+
 int cmd_run(const std::vector<std::string>& args) {
   std::string scenario_path, out_dir;
   std::vector<std::string> overrides;
-  bool json = false, quiet = false;
+  bool json = false, quiet = false, plots = false;
+  PlotOptions plot_options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&](const char* flag) -> std::string {
       if (i + 1 >= args.size()) throw UserError(std::string(flag) + " needs a value");
       return args[++i];
     };
-    if (a == "--set") overrides.push_back(value("--set"));
+    if (plot_option(args, i, plot_options)) continue;
+    if (a == "--plots") plots = true;
+    else if (a == "--set") overrides.push_back(value("--set"));
     else if (a.rfind("--set=", 0) == 0) overrides.push_back(a.substr(6));
     else if (a == "--out") out_dir = value("--out");
     else if (a == "--json") json = true;
@@ -63,9 +104,30 @@ int cmd_run(const std::vector<std::string>& args) {
   write_file_atomic(out_dir + "/log.csv", log_csv(result.log));
   write_file_atomic(out_dir + "/summary.json", js);
 
-  if (json) std::cout << js;
-  else if (!quiet || !failed.empty()) std::cout << summary_text(sc, result, failed) << "  output      " << out_dir << "/\n";
+  std::vector<std::string> figures;
+  if (plots) figures = plot_run(out_dir, plot_options);
+
+  if (json) {
+    std::cout << js;
+  } else if (!quiet || !failed.empty()) {
+    std::cout << summary_text(sc, result, failed) << "  output      " << out_dir << "/\n";
+    for (const auto& f : figures) std::cout << "  figure      " << f << "\n";
+  }
   return failed.empty() ? 0 : 3;
+}
+
+int cmd_plot(const std::vector<std::string>& args) {
+  std::string dir;
+  PlotOptions options;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (plot_option(args, i, options)) continue;
+    if (!args[i].empty() && args[i][0] == '-') throw UserError("unknown option " + args[i] + "\n" + kUsage);
+    if (!dir.empty()) throw UserError("more than one run folder given: " + dir + " and " + args[i]);
+    dir = args[i];
+  }
+  if (dir.empty()) throw UserError(std::string("plot needs a run folder\n") + kUsage);
+  for (const auto& f : plot_run(dir, options)) std::cout << f << "\n";
+  return 0;
 }
 
 int cmd_check_track(const std::vector<std::string>& args) {
@@ -95,6 +157,7 @@ int run_cli(const std::vector<std::string>& args) {
     const std::vector<std::string> rest(args.begin() + 1, args.end());
     if (args[0] == "run") return cmd_run(rest);
     if (args[0] == "check-track") return cmd_check_track(rest);
+    if (args[0] == "plot") return cmd_plot(rest);
     throw UserError("unknown command '" + args[0] + "'\n" + kUsage);
   } catch (const std::exception& e) {
     // user errors (and track errors) carry their file:line already

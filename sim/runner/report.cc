@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "sim/world/track.h"
@@ -15,30 +16,6 @@ std::string fixed(double v, int decimals) {
   std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
   return buf;
 }
-
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
-// JSON has no NaN or infinity
-std::string json_number(double v) { return std::isfinite(v) ? fmt(v) : "null"; }
 
 }  // namespace
 
@@ -120,41 +97,43 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
 }
 
 std::string summary_json(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed) {
-  std::ostringstream o;
+  using Json = nlohmann::ordered_json;
   const auto& ev = r.event;
   const events::Rules rules = events::rules_for(s.scenario.event);
-  o << "{\"scenario\":" << json_string(s.name) << ",\"track\":" << json_string(s.track_path)
-    << ",\"event\":" << json_string(events::to_string(s.scenario.event)) << ",\"seed\":" << s.scenario.seed
-    << ",\"finished\":" << (ev.finished ? "true" : "false") << ",\"dnf_reason\":" << json_string(ev.dnf_reason)
-    << ",\"laps\":[";
+  auto tracking = [](double rms, double max, double itae) { return Json{{"rms", rms}, {"max", max}, {"itae", itae}}; };
+  Json laps = Json::array();
   for (std::size_t i = 0; i < ev.laps.size(); ++i) {
     const auto& lap = ev.laps[i];
     const auto& tr = r.lap_tracking[i];
-    o << (i ? "," : "") << "{\"lap\":" << lap.number << ",\"time\":" << json_number(lap.time)
-      << ",\"timed\":" << (lap.timed ? "true" : "false") << ",\"doo\":" << lap.doo << ",\"oc\":" << lap.oc
-      << ",\"tracking\":{\"rms\":" << json_number(tr.rms) << ",\"max\":" << json_number(tr.max)
-      << ",\"itae\":" << json_number(tr.itae) << "}}";
+    laps.push_back({{"lap", lap.number}, {"start", lap.start}, {"time", lap.time}, {"timed", lap.timed},
+                    {"doo", lap.doo}, {"oc", lap.oc}, {"tracking", tracking(tr.rms, tr.max, tr.itae)}});
+  }
+  Json cones = Json::array();
+  for (const ConeHit& c : r.cones_hit) {
+    cones.push_back({{"x", c.position.x}, {"y", c.position.y}, {"color", std::string(cone_tag(c.color))},
+                     {"t", c.t}, {"cause", c.knocked ? "knocked" : "displaced"}});
   }
   const double penalty_s = rules.doo_penalty * ev.doo + rules.oc_penalty * ev.oc + rules.uss_penalty * ev.uss;
-  o << "],\"penalties\":{\"doo\":" << ev.doo << ",\"oc\":" << ev.oc << ",\"uss\":" << ev.uss
-    << ",\"seconds\":" << json_number(penalty_s) << ",\"cones\":[";
-  for (std::size_t i = 0; i < r.cones_hit.size(); ++i) {
-    const ConeHit& c = r.cones_hit[i];
-    o << (i ? "," : "") << "{\"x\":" << json_number(c.position.x) << ",\"y\":" << json_number(c.position.y)
-      << ",\"color\":" << json_string(std::string(cone_tag(c.color))) << ",\"t\":" << json_number(c.t)
-      << ",\"cause\":" << json_string(c.knocked ? "knocked" : "displaced") << "}";
-  }
-  o << "]}"
-    << ",\"raw_time\":" << json_number(ev.raw_time) << ",\"total_time\":" << json_number(ev.total_time)
-    << ",\"sim_time\":" << json_number(r.sim_time) << ",\"wall_time\":" << json_number(r.wall_time)
-    << ",\"realtime_factor\":" << json_number(r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0)
-    << ",\"tracking\":{\"rms\":" << json_number(r.tracking.rms) << ",\"max\":" << json_number(r.tracking.max)
-    << ",\"itae\":" << json_number(r.tracking.itae) << "}"
-    << ",\"stack\":{\"fallbacks\":" << r.fallbacks << ",\"fault\":" << json_string(r.fault) << "}"
-    << ",\"expectations_failed\":[";
-  for (std::size_t i = 0; i < failed.size(); ++i) o << (i ? "," : "") << json_string(failed[i]);
-  o << "]}\n";
-  return o.str();
+  // JSON has no NaN or infinity: nlohmann writes them as null
+  const Json j = {
+      {"scenario", s.name},
+      {"track", s.track_path},
+      {"event", events::to_string(s.scenario.event)},
+      {"seed", s.scenario.seed},
+      {"finished", ev.finished},
+      {"dnf_reason", ev.dnf_reason},
+      {"laps", laps},
+      {"penalties", {{"doo", ev.doo}, {"oc", ev.oc}, {"uss", ev.uss}, {"seconds", penalty_s}, {"cones", cones}}},
+      {"raw_time", ev.raw_time},
+      {"total_time", ev.total_time},
+      {"sim_time", r.sim_time},
+      {"wall_time", r.wall_time},
+      {"realtime_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0},
+      {"tracking", tracking(r.tracking.rms, r.tracking.max, r.tracking.itae)},
+      {"stack", {{"fallbacks", r.fallbacks}, {"fault", r.fault}}},
+      {"expectations_failed", failed},
+  };
+  return j.dump() + "\n";
 }
 
 std::string log_csv(const std::vector<LogRow>& log) {

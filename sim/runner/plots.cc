@@ -1,0 +1,176 @@
+#include "sim/runner/plots.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+
+#include "render/figures.h"
+#include "sim/runner/files.h"
+#include "sim/runner/report.h"
+#include "sim/runner/scenario.h"
+#include "sim/vehicle/vehicle.h"
+#include "sim/world/track.h"
+
+namespace paddock::runner {
+namespace {
+
+const char* kLogHeader =
+    "t,x,y,yaw,vx,vy,yaw_rate,steer_cmd,steer,throttle,brake,v_ref,lateral_error,heading_error,s,lap,as_state";
+constexpr int kLogColumns = 17;
+
+// the laps of summary.json, as far as the lap chart and the lap markers need them
+struct SummaryLaps {
+  std::vector<double> start, time;
+  std::vector<bool> timed;
+  std::vector<int> doo, oc;
+  double total_time = 0.0;
+  bool finished = false;
+  std::string scenario;  // the scenario's name
+};
+
+SummaryLaps read_summary(const std::string& path) {
+  const std::string text = read_file(path);
+  SummaryLaps s;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    for (const auto& lap : j.at("laps")) {
+      s.start.push_back(lap.at("start").get<double>());
+      s.time.push_back(lap.at("time").get<double>());
+      s.timed.push_back(lap.at("timed").get<bool>());
+      s.doo.push_back(lap.at("doo").get<int>());
+      s.oc.push_back(lap.at("oc").get<int>());
+    }
+    s.total_time = j.at("total_time").get<double>();
+    s.finished = j.at("finished").get<bool>();
+    s.scenario = j.at("scenario").get<std::string>();
+  } catch (const nlohmann::json::exception& e) {
+    throw UserError(path + ": not a paddock summary: " + e.what());
+  }
+  return s;
+}
+
+void write_png(const std::string& path, const render::Image& image) {
+  const std::vector<std::uint8_t> png = render::encode_png(image);
+  write_file_atomic(path, std::string(png.begin(), png.end()));
+}
+
+}  // namespace
+
+std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& source) {
+  std::vector<LogRow> rows;
+  std::size_t pos = 0;
+  int line = 0;
+  while (pos < text.size()) {
+    const auto nl = text.find('\n', pos);
+    std::string s = text.substr(pos, nl == std::string::npos ? std::string::npos : nl - pos);
+    pos = nl == std::string::npos ? text.size() : nl + 1;
+    ++line;
+    if (!s.empty() && s.back() == '\r') s.pop_back();
+    if (line == 1) {
+      if (s != kLogHeader) throw UserError(source + ":1: not a paddock log: expected the header '" + std::string(kLogHeader) + "'");
+      continue;
+    }
+    if (s.empty()) continue;
+    double v[kLogColumns];
+    const char* p = s.c_str();
+    for (int c = 0; c < kLogColumns; ++c) {
+      char* end = nullptr;
+      errno = 0;
+      v[c] = std::strtod(p, &end);
+      const char want = c + 1 < kLogColumns ? ',' : '\0';
+      if (end == p || errno == ERANGE || *end != want) {
+        throw UserError(source + ":" + std::to_string(line) + ": column " + std::to_string(c + 1) +
+                        " is not a number or the row does not have " + std::to_string(kLogColumns) + " columns");
+      }
+      p = end + (want ? 1 : 0);
+    }
+    LogRow r;
+    r.t = v[0];
+    r.x = v[1];
+    r.y = v[2];
+    r.yaw = v[3];
+    r.vx = v[4];
+    r.vy = v[5];
+    r.yaw_rate = v[6];
+    r.steer_cmd = v[7];
+    r.steer = v[8];
+    r.throttle = v[9];
+    r.brake = v[10];
+    r.v_ref = v[11];
+    r.lateral_error = v[12];
+    r.heading_error = v[13];
+    r.s = v[14];
+    r.lap = static_cast<int>(v[15]);
+    r.as_state = static_cast<int>(v[16]);
+    rows.push_back(r);
+  }
+  if (line == 0) throw UserError(source + ": empty file, expected a paddock log");
+  return rows;
+}
+
+std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) {
+  // the run's files: its resolved scenario names the track
+  const Scenario sc = load_scenario(dir + "/scenario.ini");
+  const world::TrackModel track = world::build_track(load_track_file(sc.track_path));
+  const std::vector<LogRow> log = parse_log_csv(read_file(dir + "/log.csv"), dir + "/log.csv");
+  const SummaryLaps laps = read_summary(dir + "/summary.json");
+  const std::string font_text = read_file(o.font_path);
+  const std::vector<std::uint8_t> font(font_text.begin(), font_text.end());
+  const std::string event = events::to_string(sc.scenario.event);
+
+  render::FigureStyle map_style;
+  map_style.width = map_style.height = o.map_size;
+  map_style.dpi = o.dpi;
+  map_style.font = &font;
+  render::FigureStyle chart_style = map_style;
+  chart_style.width = o.chart_width;
+  chart_style.height = o.chart_height;
+
+  // the map: the track, and the path driven coloured by speed
+  render::TrackMapData map;
+  map.title = laps.scenario + ": " + event + " on " + track.name + (laps.finished ? ", total " + fmt(std::round(laps.total_time * 1000.0) / 1000.0) + " s" : ", DNF");
+  map.cones = track.cones;
+  map.left = track.left;
+  map.right = track.right;
+  map.closed = track.closed;
+  map.gates = track.gates;
+  map.start = start_pose(track, vehicle::footprint(sc.vehicle).x_max);
+  for (const LogRow& r : log) {
+    map.trajectory.push_back({r.x, r.y});
+    map.speed.push_back(std::hypot(r.vx, r.vy));
+  }
+
+  // the controller data over the whole run, laps marked
+  render::ControllerData ctl;
+  ctl.title = laps.scenario + ": controller data";
+  for (const LogRow& r : log) {
+    ctl.t.push_back(r.t);
+    ctl.steer_cmd.push_back(r.steer_cmd);
+    ctl.steer.push_back(r.steer);
+    ctl.v_ref.push_back(r.v_ref);
+    ctl.v.push_back(r.vx);
+    ctl.lateral_error.push_back(r.lateral_error);
+    ctl.heading_error.push_back(r.heading_error);
+  }
+  ctl.lap_starts = laps.start;
+
+  // the lap chart with the event's penalties
+  const events::Rules rules = events::rules_for(sc.scenario.event);
+  render::LapChartData chart;
+  chart.title = laps.scenario + ": lap times";
+  chart.lap_times = laps.time;
+  chart.timed = laps.timed;
+  chart.doo = laps.doo;
+  chart.oc = laps.oc;
+  chart.doo_penalty = rules.doo_penalty;
+  chart.oc_penalty = rules.oc_penalty;
+
+  const std::vector<std::string> paths = {dir + "/map.png", dir + "/controller.png", dir + "/laps.png"};
+  write_png(paths[0], render::draw_track_map(map, map_style).image);
+  write_png(paths[1], render::draw_controller_data(ctl, chart_style).image);
+  write_png(paths[2], render::draw_lap_chart(chart, chart_style).image);
+  return paths;
+}
+
+}  // namespace paddock::runner

@@ -1,0 +1,29 @@
+#pragma once
+// the figures of a finished run, drawn from its files: DIR/scenario.ini (which
+// names the track), DIR/log.csv and DIR/summary.json. `paddock run --plots`
+// and `paddock plot DIR` both come here, so a redraw is the same picture.
+#include <string>
+#include <vector>
+
+#include "sim/runner/simulation.h"
+
+namespace paddock::runner {
+
+struct PlotOptions {
+  int map_size = 1600;       // px, the square track map
+  int chart_width = 1600;    // px, the controller data and lap charts
+  int chart_height = 1200;   // px
+  double dpi = 150.0;        // px per inch: text and line sizes are in points
+  // a TrueType font from Debian's fonts-dejavu-core
+  std::string font_path = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+};
+
+// draws DIR/map.png, DIR/controller.png and DIR/laps.png (each written
+// atomically) and returns their paths; throws UserError naming the file and
+// line of anything it cannot read
+std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& options);
+
+// log.csv as written by log_csv(); throws UserError "source:line: ..."
+std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& source);
+
+}  // namespace paddock::runner

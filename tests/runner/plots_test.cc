@@ -1,0 +1,152 @@
+// the figures of a run as a user gets them: `run --plots` and `plot DIR`, their
+// sizes, and clear errors for missing, broken or unwritable files
+#include "sim/runner/plots.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+
+#include "render/figures.h"
+#include "sim/runner/files.h"
+
+namespace paddock::runner {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const std::string kRoot = PADDOCK_SOURCE_DIR;
+
+struct Outcome {
+  int code = -1;
+  std::string output;
+};
+
+Outcome paddock(const std::string& args) {
+  Outcome o;
+  FILE* p = popen((std::string(PADDOCK_BINARY) + " " + args + " 2>&1").c_str(), "r");
+  if (!p) return o;
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) o.output.append(buf.data(), n);
+  const int status = pclose(p);
+  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return o;
+}
+
+std::string scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / "paddock_plots_test" / name;
+  fs::remove_all(d);
+  fs::create_directories(d.parent_path());
+  return d.string();
+}
+
+render::Image png_at(const std::string& path) {
+  const std::string bytes = read_file(path);
+  return render::decode_png(std::vector<std::uint8_t>(bytes.begin(), bytes.end()));
+}
+
+TEST(Plots, RunWithPlotsDrawsTheThreeFiguresAtTheDefaultSizes) {
+  const std::string dir = scratch("run");
+  const auto o = paddock("run " + kRoot + "/scenarios/fsg_2019_autocross.ini --plots --out " + dir);
+  ASSERT_EQ(o.code, 0) << o.output;
+  EXPECT_THAT(o.output, HasSubstr(dir + "/map.png"));
+  const render::Image map = png_at(dir + "/map.png");
+  EXPECT_EQ(map.width, 1600);
+  EXPECT_EQ(map.height, 1600);
+  const render::Image ctl = png_at(dir + "/controller.png");
+  EXPECT_EQ(ctl.width, 1600);
+  EXPECT_EQ(ctl.height, 1200);
+  const render::Image laps = png_at(dir + "/laps.png");
+  EXPECT_EQ(laps.width, 1600);
+  EXPECT_EQ(laps.height, 1200);
+  // a figure is a picture, not a blank page: many pixels differ from the corner
+  int drawn = 0;
+  const render::Rgba bg = map.pixel(0, 0);
+  for (int y = 0; y < map.height; y += 4)
+    for (int x = 0; x < map.width; x += 4) drawn += map.pixel(x, y) == bg ? 0 : 1;
+  EXPECT_GT(drawn, 2000);
+}
+
+TEST(Plots, PlotRedrawsAFinishedRunWithOtherSizesAndTheSameFiles) {
+  const std::string dir = scratch("redraw");
+  ASSERT_EQ(paddock("run " + kRoot + "/scenarios/skidpad.ini --plots --out " + dir).code, 0);
+  const std::string first = read_file(dir + "/map.png");
+  // the same options draw the same bytes
+  ASSERT_EQ(paddock("plot " + dir).code, 0);
+  EXPECT_TRUE(read_file(dir + "/map.png") == first);
+  const auto o = paddock("plot " + dir + " --map-size 800 --chart-size 900x600 --dpi 100");
+  ASSERT_EQ(o.code, 0) << o.output;
+  EXPECT_EQ(png_at(dir + "/map.png").width, 800);
+  EXPECT_EQ(png_at(dir + "/controller.png").width, 900);
+  EXPECT_EQ(png_at(dir + "/controller.png").height, 600);
+}
+
+TEST(Plots, MissingRunFolderIsNamed) {
+  const auto o = paddock("plot " + scratch("nothing_here"));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr("nothing_here/scenario.ini: cannot open"));
+}
+
+TEST(Plots, BrokenLogIsAFileLineError) {
+  const std::string dir = scratch("broken");
+  ASSERT_EQ(paddock("run " + kRoot + "/scenarios/acceleration.ini --out " + dir).code, 0);
+  std::string log = read_file(dir + "/log.csv");
+  // break the fourth line (the third row)
+  std::size_t pos = 0;
+  for (int i = 0; i < 3; ++i) pos = log.find('\n', pos) + 1;
+  log.insert(pos, "oops,");
+  write_file_atomic(dir + "/log.csv", log);
+  const auto o = paddock("plot " + dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr(dir + "/log.csv:4: column 1 is not a number"));
+}
+
+TEST(Plots, UnwritableOutputIsAClearError) {
+  const std::string dir = scratch("unwritable");
+  ASSERT_EQ(paddock("run " + kRoot + "/scenarios/acceleration.ini --out " + dir).code, 0);
+  fs::create_directories(dir + "/map.png/in_the_way");  // a folder where the figure goes
+  const auto o = paddock("plot " + dir);
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr(dir + "/map.png: cannot rename into place"));
+  // and a run whose output folder cannot be made
+  const std::string a_file = scratch("a_file");
+  write_file_atomic(a_file, "x");
+  const auto r = paddock("run " + kRoot + "/scenarios/acceleration.ini --out " + a_file + "/sub");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_THAT(r.output, HasSubstr("cannot create folder"));
+}
+
+TEST(Plots, BadPlotOptionsAreErrors) {
+  EXPECT_THAT(paddock("plot x --map-size 10").output, HasSubstr("--map-size 10: expected a whole number from 200 to 10000"));
+  EXPECT_THAT(paddock("plot x --chart-size 800").output, HasSubstr("expected WIDTHxHEIGHT"));
+}
+
+TEST(LogCsv, ParsesWhatTheRunWritesAndRejectsTheRest) {
+  const std::string header =
+      "t,x,y,yaw,vx,vy,yaw_rate,steer_cmd,steer,throttle,brake,v_ref,lateral_error,heading_error,s,lap,as_state\n";
+  const auto rows = parse_log_csv(header + "0.5,1,2,0.1,3,0,0,0,0,1,0,4,-0.25,0,7,1,2\n", "l.csv");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].t, 0.5);
+  EXPECT_EQ(rows[0].lateral_error, -0.25);
+  EXPECT_EQ(rows[0].lap, 1);
+  EXPECT_EQ(rows[0].as_state, 2);
+  auto error = [](const std::string& text) {
+    try {
+      parse_log_csv(text, "l.csv");
+    } catch (const UserError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_THAT(error("a,b\n"), HasSubstr("l.csv:1: not a paddock log"));
+  EXPECT_THAT(error(header + "1,2,3\n"), HasSubstr("l.csv:2: column 3"));
+  EXPECT_THAT(error(""), HasSubstr("l.csv: empty file"));
+}
+
+}  // namespace
+}  // namespace paddock::runner
