@@ -2,7 +2,9 @@
 // what crosses the HAL: timestamped sensor messages in, actuator commands out.
 // The sim back end and the hardware back end produce exactly these.
 #include <variant>
+#include <vector>
 
+#include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
 #include "autonomy/common/time.h"
 
@@ -29,7 +31,20 @@ struct ResSignal {
   bool emergency = false;
 };
 
-using SensorMessage = std::variant<StateEstimate, ResSignal>;
+// a cone seen by perception, in the vehicle base frame at the measurement time
+struct DetectedCone {
+  Vec2 position;                        // base frame (m)
+  ConeColor color = ConeColor::Unknown;
+};
+
+// one frame of cone detections (the `perception = ground_truth` source: an
+// object-level sensor standing in for a real pipeline's output)
+struct ConeDetections {
+  TimeNs stamp = 0;  // when the cones were measured; the message arrives later (latency)
+  std::vector<DetectedCone> cones;
+};
+
+using SensorMessage = std::variant<StateEstimate, ResSignal, ConeDetections>;
 
 // the stack's command to the car's low-level controllers
 struct ActuatorCommand {
