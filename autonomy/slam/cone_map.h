@@ -1,0 +1,50 @@
+#pragma once
+// the stack's map of cones, built from detections at known poses: each
+// detection is associated with the nearest mapped cone within a gate, whose
+// position is the running mean of its observations and whose colour is the
+// majority of the coloured votes. With `slam = ground_truth` the poses are the
+// true ones; a SLAM back end later feeds its own estimates in.
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "autonomy/common/cone.h"
+#include "autonomy/common/geometry.h"
+
+namespace paddock::slam {
+
+struct ConeMapParams {
+  // a detection farther than this from every mapped cone starts a new one (m):
+  // half the smallest cone spacing of a real track (~2 m in a hairpin) keeps
+  // neighbours apart while absorbing centimetres of noise
+  double association_distance = 1.0;
+  // observations before a cone counts as real (-): a false positive of a good
+  // pipeline rarely repeats at the same place, a real cone is seen every frame
+  int min_observations = 2;
+};
+
+struct MappedCone {
+  Vec2 position;                     // mean of the associated observations (m, map frame)
+  int observations = 0;
+  std::array<int, 5> votes{};        // per ConeColor, in enum order
+  ConeColor color() const;           // the most voted colour, ignoring unknown unless it is all there is
+};
+
+class ConeMap {
+ public:
+  explicit ConeMap(const ConeMapParams& params = {});
+
+  // one frame of detections in the map frame; non-finite positions are skipped
+  void add(const std::vector<Cone>& detections);
+  // the cones seen at least min_observations times
+  std::vector<Cone> cones() const;
+  const std::vector<MappedCone>& all() const { return cones_; }
+  std::size_t size() const { return cones_.size(); }
+  void clear() { cones_.clear(); }
+
+ private:
+  ConeMapParams params_;
+  std::vector<MappedCone> cones_;
+};
+
+}  // namespace paddock::slam
