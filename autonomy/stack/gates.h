@@ -1,0 +1,27 @@
+#pragma once
+// timekeeping gates from the cone map: the big orange cones of a start,
+// finish or timing line, grouped into posts and paired across the track.
+#include <vector>
+
+#include "autonomy/common/cone.h"
+#include "autonomy/common/geometry.h"
+
+namespace paddock::stack {
+
+struct GateParams {
+  double post_radius = 1.0;   // big orange cones closer than this form one post (m)
+  double min_width = 2.5;     // posts of one gate are at least this far apart (m): the track is >= 3 m wide
+  double max_width = 12.0;    // and at most this far (m): FS timing posts stand a few metres off the track
+};
+
+// the gates the big orange cones of `cones` form, each as a segment between
+// its two posts (unoriented: orient with orient_gate); a post pairs with its
+// nearest other post when that one's nearest is it too and their distance is
+// in [min_width, max_width]
+std::vector<Segment> find_gates(const std::vector<Cone>& cones, const GateParams& params = {});
+
+// the gate with its left post first as seen driving along `direction`, so that
+// driving that way crosses it from its right side to its left (crossing_right_to_left)
+Segment orient_gate(const Segment& gate, Vec2 direction);
+
+}  // namespace paddock::stack
