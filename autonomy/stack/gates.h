@@ -9,7 +9,9 @@
 namespace paddock::stack {
 
 struct GateParams {
-  double post_radius = 1.0;   // big orange cones closer than this form one post (m)
+  // big orange cones closer than this form one post (m): the rules put them in
+  // pairs before and after the line, ~1.2 m apart (FSG 2024)
+  double post_radius = 1.5;
   double min_width = 2.5;     // posts of one gate are at least this far apart (m): the track is >= 3 m wide
   double max_width = 12.0;    // and at most this far (m): FS timing posts stand a few metres off the track
 };

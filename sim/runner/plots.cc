@@ -130,7 +130,7 @@ std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) 
   // the map: the track, and the path driven coloured by speed
   render::TrackMapData map;
   map.title = laps.scenario + ": " + event + " on " + track.name + (laps.finished ? ", total " + fmt(std::round(laps.total_time * 1000.0) / 1000.0) + " s" : ", DNF");
-  map.cones = track.cones;
+  map.cones = event_cones(track);
   map.left = track.left;
   map.right = track.right;
   map.closed = track.closed;

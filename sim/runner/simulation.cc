@@ -75,6 +75,17 @@ stack::MissionSpec mission_for(events::EventKind kind, const world::TrackModel& 
   return m;
 }
 
+std::vector<Cone> event_cones(const world::TrackModel& track) {
+  std::vector<Cone> cones = track.cones;
+  for (const Cone& c : cones)
+    if (c.color == ConeColor::BigOrange) return cones;
+  for (const Segment& g : track.gates) {
+    cones.push_back({g.a, ConeColor::BigOrange});
+    cones.push_back({g.b, ConeColor::BigOrange});
+  }
+  return cones;
+}
+
 Pose2 start_pose(const world::TrackModel& track, double nose_offset) {
   Pose2 start = track.start;
   if (track.gates.empty()) return start;
@@ -107,7 +118,7 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   // the world: car at the start pose, at rest, brakes on; cones in place
   const vehicle::Footprint footprint = vehicle::footprint(vp);
   vehicle::VehicleState car = vehicle::initial_state(vp, start_pose(track, footprint.x_max));
-  world::ConeWorld cones(track.cones, sc.cones, world::Footprint{-footprint.x_min, footprint.x_max, footprint.y_max});
+  world::ConeWorld cones(event_cones(track), sc.cones, world::Footprint{-footprint.x_min, footprint.x_max, footprint.y_max});
   events::Event event(sc.scenario.event, track, sc.event);
   stack::Stack stack(stack_params(sc), mission_for(sc.scenario.event, track));
   SimHal hal;

@@ -70,6 +70,11 @@ struct RunResult {
 // ground-truth path of the event)
 stack::MissionSpec mission_for(events::EventKind kind, const world::TrackModel& track);
 
+// the cones standing at the event: the track's, plus a big orange cone at
+// each timekeeping post when the file has no big orange cones at all (the
+// rules mark timekeeping lines with them; some files only give the posts)
+std::vector<Cone> event_cones(const world::TrackModel& track);
+
 // where the car starts: the track's start pose, moved back along its heading
 // when that would put the car's nose less than 0.3 m behind the first gate
 // (the rules' start position; some files give the pose of the car's centre)
