@@ -20,7 +20,7 @@ const char* to_string(Mission m) {
 }
 
 Stack::Stack(const StackParams& params, MissionSpec spec)
-    : params_(params), spec_(std::move(spec)), controller_(params.control, params.vehicle) {
+    : params_(params), spec_(std::move(spec)), controller_(params.control, params.vehicle), cone_map_(params.cone_map) {
   // planner = oracle: the whole reference is planned once, before the start;
   // an open path starts free (the car launches at full drive) and ends at rest
   const std::optional<double> v_end =
@@ -37,10 +37,38 @@ Stack::Stack(const StackParams& params, MissionSpec spec)
 void Stack::on_message(const hal::SensorMessage& m) {
   if (const auto* est = std::get_if<hal::StateEstimate>(&m)) {
     state_ = *est;
+    history_.push_back(*est);
+    while (!history_.empty() && est->stamp - history_.front().stamp > kNsPerSecond) history_.pop_front();
+  } else if (const auto* det = std::get_if<hal::ConeDetections>(&m)) {
+    on_detections(*det);
   } else if (const auto* res = std::get_if<hal::ResSignal>(&m)) {
     go_ = go_ || res->go;
     emergency_ = emergency_ || res->emergency;
   }
+}
+
+std::optional<Pose2> Stack::pose_at(TimeNs t) const {
+  if (history_.empty() || t < history_.front().stamp || t > history_.back().stamp) return std::nullopt;
+  // the two estimates around t, linearly interpolated (yaw on the circle)
+  std::size_t i = 1;
+  while (i < history_.size() && history_[i].stamp < t) ++i;
+  if (i == history_.size()) return history_.back().pose;
+  const hal::StateEstimate& a = history_[i - 1];
+  const hal::StateEstimate& b = history_[i];
+  const double f = b.stamp > a.stamp ? static_cast<double>(t - a.stamp) / static_cast<double>(b.stamp - a.stamp) : 1.0;
+  return Pose2{a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y),
+               wrap_angle(a.pose.yaw + f * wrap_angle(b.pose.yaw - a.pose.yaw))};
+}
+
+void Stack::on_detections(const hal::ConeDetections& d) {
+  // slam = ground_truth: the detections go into the map at the pose the car had when they were measured
+  const std::optional<Pose2> pose = pose_at(d.stamp);
+  if (!pose) return;
+  std::vector<Cone> in_map;
+  in_map.reserve(d.cones.size());
+  for (const hal::DetectedCone& c : d.cones) in_map.push_back({pose->transform(c.position), c.color});
+  cone_map_.add(in_map);
+  telemetry_.mapped_cones = static_cast<int>(cone_map_.cones().size());
 }
 
 hal::ActuatorCommand Stack::safe_stop(TimeNs now, const std::string& reason) {

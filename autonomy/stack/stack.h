@@ -1,6 +1,7 @@
 #pragma once
 // the autonomy pipeline behind the HAL: mission logic, the AS state machine,
 // planning and control at the control rate.
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "autonomy/control/controller.h"
 #include "autonomy/hal/hal.h"
 #include "autonomy/planning/reference.h"
+#include "autonomy/slam/cone_map.h"
 
 namespace paddock::stack {
 
@@ -40,6 +42,7 @@ struct StackParams {
   control::ControlParams control;
   control::VehicleKnowledge vehicle;
   MissionParams mission;
+  slam::ConeMapParams cone_map;
 };
 
 // what the car is told before the start
@@ -63,6 +66,7 @@ struct Telemetry {
   bool stopping = false;      // the mission is over and the car brakes to a stop
   int fallbacks = 0;          // control cycles that ran the safe stop instead of the plan
   std::string last_fault;     // the reason of the last fallback or planning failure
+  int mapped_cones = 0;       // cones in the stack's map (seen often enough)
 };
 
 class Stack {
@@ -74,9 +78,13 @@ class Stack {
 
   const Telemetry& telemetry() const { return telemetry_; }
   const Trajectory& trajectory() const { return trajectory_; }
+  const slam::ConeMap& cone_map() const { return cone_map_; }
 
  private:
   void on_message(const hal::SensorMessage& m);
+  void on_detections(const hal::ConeDetections& d);
+  // the base pose at time t from the recent state estimates (interpolated), if known
+  std::optional<Pose2> pose_at(TimeNs t) const;
   hal::ActuatorCommand safe_stop(TimeNs now, const std::string& reason);
 
   StackParams params_;
@@ -86,6 +94,8 @@ class Stack {
   Telemetry telemetry_;
 
   std::optional<hal::StateEstimate> state_;
+  std::deque<hal::StateEstimate> history_;  // the last second of state estimates, oldest first
+  slam::ConeMap cone_map_;
   std::optional<Vec2> last_base_position_;  // for the finish-line crossing test
   bool go_ = false;
   bool emergency_ = false;

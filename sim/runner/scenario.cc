@@ -130,6 +130,40 @@ void add_vehicle_fields(std::vector<Field>& f) {
 
 #define ACC(member) [](auto& s) -> auto& { return s.member; }
 
+// [perception]: the object-level cone sensor (perception = ground_truth)
+void add_perception_fields(std::vector<Field>& f) {
+  f.push_back(real_field("perception", "mount_x", "m", -10.0, 10.0, "sensor position ahead of the rear axle", ACC(perception.mount_x)));
+  f.push_back(real_field("perception", "mount_y", "m", -5.0, 5.0, "sensor position left of the centre", ACC(perception.mount_y)));
+  f.push_back(real_field("perception", "range_min", "m", 0.0, 1000.0, "nearest cone seen", ACC(perception.range_min)));
+  f.push_back(real_field("perception", "range_max", "m", 0.1, 1000.0, "farthest cone seen", ACC(perception.range_max)));
+  f.push_back(real_field("perception", "fov", "rad", 0.01, 2.0 * kPi, "horizontal field of view, centred forward", ACC(perception.fov)));
+  f.push_back(bool_field("perception", "occlusion", "cones hide cones behind them", ACC(perception.occlusion)));
+  f.push_back(real_field("perception", "occlusion_fraction", "", 0.0, 1.0, "share of a cone's bearing that must be covered to hide it",
+                         ACC(perception.occlusion_fraction)));
+  f.push_back(real_field("perception", "range_noise", "m", 0.0, 10.0, "range noise std at 0 m", ACC(perception.range_noise)));
+  f.push_back(real_field("perception", "range_noise_per_m", "m/m", 0.0, 1.0, "growth of the range noise std with range",
+                         ACC(perception.range_noise_per_m)));
+  f.push_back(real_field("perception", "bearing_noise", "rad", 0.0, 1.0, "bearing noise std", ACC(perception.bearing_noise)));
+  f.push_back(real_field("perception", "miss_probability", "", 0.0, 1.0, "chance a cone in view is missed, near",
+                         ACC(perception.miss_probability)));
+  f.push_back(real_field("perception", "miss_probability_growth", "", 0.0, 1.0, "added at range_max (quadratic in range)",
+                         ACC(perception.miss_probability_growth)));
+  f.push_back(real_field("perception", "unknown_color_probability", "", 0.0, 1.0, "chance of no colour, near",
+                         ACC(perception.unknown_color_probability)));
+  f.push_back(real_field("perception", "unknown_color_growth", "", 0.0, 1.0, "added at range_max (quadratic in range)",
+                         ACC(perception.unknown_color_growth)));
+  f.push_back(real_field("perception", "color_flip_probability", "", 0.0, 1.0, "chance of the look-alike colour, near",
+                         ACC(perception.color_flip_probability)));
+  f.push_back(real_field("perception", "color_flip_growth", "", 0.0, 1.0, "added at range_max (quadratic in range)",
+                         ACC(perception.color_flip_growth)));
+  f.push_back(real_field("perception", "false_positives_per_frame", "", 0.0, 100.0, "mean ghost cones per frame (Poisson)",
+                         ACC(perception.false_positives_per_frame)));
+  f.push_back(real_field("perception", "false_positive_unknown_probability", "", 0.0, 1.0, "share of ghosts without colour",
+                         ACC(perception.false_positive_unknown_probability)));
+  f.push_back(real_field("perception", "latency", "s", 0.0, 10.0, "measurement to delivery", ACC(perception.latency)));
+  f.push_back(real_field("perception", "rate", "Hz", 0.1, 1000.0, "frames per second", ACC(perception.rate)));
+}
+
 // [cones]: the Box2D cone world's physics
 void add_cone_fields(std::vector<Field>& f) {
   f.push_back(real_field("cones", "small_mass", "kg", 0.01, 100.0, "small cone mass", ACC(cones.small_cone.mass)));
@@ -247,7 +281,8 @@ std::vector<Field> build_fields() {
   f.push_back(int_field("sim", "control_rate", "Hz", 1, 100000, "stack cycle rate", ACC(sim.control_rate)));
   f.push_back(int_field("sim", "log_rate", "Hz", 1, 100000, "log.csv rows and off-course checks", ACC(sim.log_rate)));
 
-  // [vehicle] and [cones]: see add_vehicle_fields and add_cone_fields
+  // [perception], [vehicle] and [cones]: see add_perception_fields, add_vehicle_fields and add_cone_fields
+  add_perception_fields(f);
   add_vehicle_fields(f);
   add_cone_fields(f);
 
@@ -378,6 +413,7 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
                     " Hz) must be a whole multiple of control_rate and log_rate");
   }
   if (const char* why = control::validate(s.control, stack_params(s).vehicle)) throw UserError(path + ": [control] " + why);
+  if (const std::string why = sensors::validate(s.perception); !why.empty()) throw UserError(path + ": [perception] " + why);
 
   s.source = path;
   s.name = std::filesystem::path(path).stem().string();

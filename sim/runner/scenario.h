@@ -9,6 +9,7 @@
 
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
+#include "sim/sensors/cone_sensor.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
 #include "sim/world/track.h"
@@ -53,6 +54,7 @@ struct Scenario {
 
   ScenarioSection scenario;
   stack::AutonomyModes autonomy;
+  sensors::ConeSensorParams perception;  // the cone sensor of perception = ground_truth
   vehicle::VehicleParams vehicle;
   control::ControlParams control;
   planning::ReferenceParams planning;

@@ -1,9 +1,11 @@
 #include "sim/runner/simulation.h"
 
 #include <chrono>
+#include <deque>
 #include <cmath>
 
 #include "sim/runner/sim_hal.h"
+#include "sim/sensors/cone_sensor.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
 
@@ -123,6 +125,17 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   stack::Stack stack(stack_params(sc), mission_for(sc.scenario.event, track));
   SimHal hal;
 
+  // perception = ground_truth: the object-level cone sensor, on its own random
+  // stream of the scenario's seed, its frames delivered after their latency
+  sensors::ConeSensorParams sensor_params = sc.perception;
+  sensor_params.small_cone_radius = 0.5 * sc.cones.small_cone.base_width;
+  sensor_params.big_cone_radius = 0.5 * sc.cones.big_cone.base_width;
+  sensors::ConeSensor sensor(sensor_params, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 1);
+  const long sensor_every = std::max(1L, std::lround(sc.sim.physics_rate / sensor_params.rate));
+  std::deque<std::pair<TimeNs, hal::ConeDetections>> in_flight;  // (delivery time, frame)
+  std::vector<Cone> seen(static_cast<std::size_t>(cones.cone_count()));
+  std::vector<bool> knocked(seen.size());
+
   vehicle::DriverInput input{0.0, 0.0, 1.0};
   hal::AsState as = hal::AsState::Off;
   const TimeNs go_ns = from_seconds(sc.scenario.go_time);
@@ -136,8 +149,22 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
     const double t = static_cast<double>(k) * dt;
     Pose2 base = vehicle::base_pose(vp, car);
 
+    // a perception frame of the cones as they stand now, delivered later
+    if (k % sensor_every == 0) {
+      for (int i = 0; i < cones.cone_count(); ++i) {
+        const auto u = static_cast<std::size_t>(i);
+        seen[u] = {cones.cone_position(i), cones.cone(i).color};
+        knocked[u] = cones.cone_knocked(i);
+      }
+      in_flight.emplace_back(now + sensor.latency_ns(), sensor.measure(seen, knocked, base, now));
+    }
+
     // the control cycle: sensors into the HAL, the stack, its command to the actuators
     if (k % control_every == 0) {
+      while (!in_flight.empty() && in_flight.front().first <= now) {
+        hal.post(std::move(in_flight.front().second));
+        in_flight.pop_front();
+      }
       const Vec2 v = vehicle::base_velocity(vp, car);
       hal.post(hal::StateEstimate{now, base, v.x, v.y, car.r});
       if (!go_sent && now >= go_ns) {
