@@ -56,11 +56,11 @@ void ConeMap::add(const std::vector<Cone>& detections) {
   }
 }
 
-std::vector<Cone> ConeMap::cones() const {
+std::vector<Cone> ConeMap::cones(int at_least) const {
   std::vector<Cone> out;
   out.reserve(cones_.size());
   for (const MappedCone& m : cones_) {
-    if (m.observations >= params_.min_observations) out.push_back({m.position, m.color()});
+    if (m.observations >= at_least) out.push_back({m.position, m.color()});
   }
   return out;
 }

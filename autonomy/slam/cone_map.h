@@ -36,8 +36,9 @@ class ConeMap {
 
   // one frame of detections in the map frame; non-finite positions are skipped
   void add(const std::vector<Cone>& detections);
-  // the cones seen at least min_observations times
-  std::vector<Cone> cones() const;
+  // the cones seen at least min_observations times (or `at_least` times)
+  std::vector<Cone> cones() const { return cones(params_.min_observations); }
+  std::vector<Cone> cones(int at_least) const;
   const std::vector<MappedCone>& all() const { return cones_; }
   std::size_t size() const { return cones_.size(); }
   void clear() { cones_.clear(); }

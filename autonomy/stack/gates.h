@@ -13,7 +13,7 @@ struct GateParams {
   // pairs before and after the line, ~1.2 m apart (FSG 2024)
   double post_radius = 1.5;
   double min_width = 2.5;     // posts of one gate are at least this far apart (m): the track is >= 3 m wide
-  double max_width = 12.0;    // and at most this far (m): FS timing posts stand a few metres off the track
+  double max_width = 20.0;    // and at most this far (m): FS timing posts stand metres off the track (FSE 2023: 15.4 m apart)
 };
 
 // the gates the big orange cones of `cones` form, each as a segment between

@@ -20,12 +20,16 @@ const char* to_string(Mission m) {
 }
 
 Stack::Stack(const StackParams& params, MissionSpec spec)
-    : params_(params), spec_(std::move(spec)), controller_(params.control, params.vehicle), cone_map_(params.cone_map) {
+    : params_(params),
+      spec_(std::move(spec)),
+      controller_(params.control, params.vehicle),
+      cone_map_(params.cone_map),
+      gates_(spec_.gates) {
+  if (params_.modes.planner != PlannerMode::Oracle) return;
   // planner = oracle: the whole reference is planned once, before the start;
   // an open path starts free (the car launches at full drive) and ends at rest
-  const std::optional<double> v_end =
-      spec_.oracle_closed ? std::nullopt : std::optional<double>(0.0);
-  auto result = planning::build_reference(spec_.oracle_path, spec_.oracle_closed, params_.reference,
+  const std::optional<double> v_end = spec_.oracle_closed ? std::nullopt : std::optional<double>(0.0);
+  auto result = planning::build_reference(spec_.oracle_path, spec_.oracle_closed, params_.planner.reference,
                                           std::nullopt, v_end);
   if (result.ok()) {
     trajectory_ = std::move(result.trajectory);
@@ -68,7 +72,97 @@ void Stack::on_detections(const hal::ConeDetections& d) {
   in_map.reserve(d.cones.size());
   for (const hal::DetectedCone& c : d.cones) in_map.push_back({pose->transform(c.position), c.color});
   cone_map_.add(in_map);
-  telemetry_.mapped_cones = static_cast<int>(cone_map_.cones().size());
+  map_news_ = true;
+}
+
+void Stack::learn_gates(const Pose2& pose) {
+  if (trajectory_.empty()) return;
+  const MissionParams& mp = params_.mission;
+  for (const Segment& g : find_gates(cone_map_.cones(mp.gate_min_observations), params_.gates)) {
+    const Vec2 mid = (g.a + g.b) * 0.5;
+    bool known = false;
+    for (const Segment& k : gates_) known = known || distance((k.a + k.b) * 0.5, mid) < 3.0;
+    // a new gate lies across the path ahead, and is oriented by the heading of the car that sees it
+    if (known || dot(mid - pose.position(), pose.heading()) <= 0.0) continue;
+    if (std::abs(project(trajectory_, mid, 0.0, 0.0).offset) > mp.gate_max_offset) continue;
+    gates_.push_back(orient_gate(g, pose.heading()));
+  }
+}
+
+void Stack::plan(const hal::StateEstimate& st) {
+  map_news_ = false;
+  const std::vector<Cone> cones = cone_map_.cones();
+  telemetry_.mapped_cones = static_cast<int>(cones.size());
+  if (telemetry_.lap_locked || telemetry_.stopping) return;
+  // nothing to plan on until the map holds a few cones (the first frames)
+  if (cones.size() < 3) return;
+  const MissionParams& mp = params_.mission;
+  // the profile starts at the car's speed, but never below the launch speed,
+  // so that a car at rest gets a reference to start on
+  const double speed = std::max(st.vx, mp.launch_speed);
+
+  // skidpad: the rules' layout aligned to the cones once enough are mapped, then driven as it is
+  if (spec_.mission == Mission::Skidpad) {
+    if (static_cast<int>(cones.size()) < mp.skidpad_min_cones) return;
+    const Pose2 guess{st.pose.transform({mp.skidpad_crossing_ahead, 0.0}).x,
+                      st.pose.transform({mp.skidpad_crossing_ahead, 0.0}).y, st.pose.yaw};
+    planning::SkidpadPlan sp = planning::plan_skidpad(cones, guess, params_.skidpad);
+    ++telemetry_.plans;
+    if (!sp.ok()) {
+      ++telemetry_.plan_failures;
+      telemetry_.last_fault = "skidpad: " + sp.reason;
+      return;
+    }
+    trajectory_ = std::move(sp.trajectory);
+    telemetry_.lap_locked = true;
+    return;
+  }
+
+  // acceleration: a line fitted to the centreline, to the end of the braking zone
+  // autocross and trackdrive: the centreline of the map explored so far
+  planning::PlanResult res =
+      spec_.mission == Mission::Acceleration
+          ? planning::plan_acceleration(cones, st.pose, speed, params_.planner,
+                                        std::max(10.0, mp.acceleration_length - driven_))
+          : planning::plan_path(cones, st.pose, speed, params_.planner);
+  ++telemetry_.plans;
+  if (!res.ok()) {
+    // hold the last trajectory; with none the car stays parked
+    ++telemetry_.plan_failures;
+    telemetry_.last_fault = "planning: " + res.reason;
+  } else if (res.closed) {
+    // a closed centreline is the whole lap once the car has driven most of it;
+    // before that it is the search cutting across a map still being explored
+    if (driven_ >= mp.loop_closure_distance) {
+      trajectory_ = res.trajectory;
+      telemetry_.lap_locked = spec_.mission == Mission::Trackdrive;
+    }
+  } else {
+    trajectory_ = res.trajectory;
+  }
+  last_plan_ = std::move(res);
+  if (spec_.gates.empty()) learn_gates(st.pose);
+}
+
+void Stack::start_stopping(TimeNs now, double speed) {
+  if (telemetry_.stopping) return;
+  telemetry_.stopping = true;
+  stop_start_ = now;
+  stop_speed_ = std::max(speed, 0.0);
+}
+
+void Stack::count_crossings(Vec2 base, TimeNs now, double speed) {
+  if (last_base_position_) {
+    for (const Segment& g : gates_) {
+      if (!crossing_right_to_left(*last_base_position_, base, g)) continue;
+      // a line marked twice, or two gates close together, count once
+      if (driven_ - last_crossing_at_ < params_.mission.gate_refractory_distance) continue;
+      last_crossing_at_ = driven_;
+      ++telemetry_.finish_crossings;
+      if (spec_.finish_crossings > 0 && telemetry_.finish_crossings >= spec_.finish_crossings) start_stopping(now, speed);
+    }
+  }
+  last_base_position_ = base;
 }
 
 hal::ActuatorCommand Stack::safe_stop(TimeNs now, const std::string& reason) {
@@ -87,6 +181,9 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   while (auto m = hal.receive()) on_message(*m);
   const double dt = last_tick_ ? to_seconds(now - *last_tick_) : 0.0;
   last_tick_ = now;
+
+  // planner = delaunay: plan whenever the map has news (also before the go, so the car is ready)
+  if (params_.modes.planner == PlannerMode::Delaunay && state_ && map_news_) plan(*state_);
 
   // the AS state machine: off -> ready (plan and state known) -> driving (go)
   // -> finished (stopped after the mission); emergency from any state
@@ -108,19 +205,11 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
     return;
   }
   const hal::StateEstimate& st = *state_;
+  const double speed = std::hypot(st.vx, st.vy);
+  driven_ += speed * dt;
 
-  // mission progress: count finish-line crossings of the base origin
-  const Vec2 base = st.pose.position();
-  if (spec_.finish_line && spec_.finish_crossings > 0 && last_base_position_ &&
-      crossing_right_to_left(*last_base_position_, base, *spec_.finish_line)) {
-    ++telemetry_.finish_crossings;
-    if (telemetry_.finish_crossings >= spec_.finish_crossings && !telemetry_.stopping) {
-      telemetry_.stopping = true;
-      stop_start_ = now;
-      stop_speed_ = std::max(st.vx, 0.0);
-    }
-  }
-  last_base_position_ = base;
+  // mission progress: gate crossings of the base origin
+  count_crossings(st.pose.position(), now, st.vx);
 
   // after the finish the speed cap ramps down at the stop deceleration
   double max_speed = std::numeric_limits<double>::infinity();
@@ -144,17 +233,14 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
     return;
   }
 
-  // an open path ends at rest (the profile's end speed is 0): near its end the
-  // mission is over (the speed feedforward of the last metres' hard braking
-  // can bring the car to rest a little short of the very end)
+  // a mission without gates to count (skidpad) ends where its open path ends,
+  // at rest (the profile's end speed is 0); the speed feedforward of the last
+  // metres' hard braking can bring the car to rest a little short of the end
   const double end_margin = 3.0;  // m
-  if (!trajectory_.closed && out.diagnostics.s >= trajectory_.length - end_margin && !telemetry_.stopping) {
-    telemetry_.stopping = true;
-    stop_start_ = now;
-    stop_speed_ = std::max(st.vx, 0.0);
+  if (spec_.finish_crossings == 0 && !trajectory_.closed && out.diagnostics.s >= trajectory_.length - end_margin) {
+    start_stopping(now, st.vx);
   }
-  const bool at_rest = std::hypot(st.vx, st.vy) < params_.mission.standstill_speed;
-  if (telemetry_.stopping && at_rest) as = hal::AsState::Finished;
+  if (telemetry_.stopping && speed < params_.mission.standstill_speed) as = hal::AsState::Finished;
 
   cmd.as_state = as;
   if (as == hal::AsState::Finished) {

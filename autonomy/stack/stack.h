@@ -1,6 +1,6 @@
 #pragma once
-// the autonomy pipeline behind the HAL: mission logic, the AS state machine,
-// planning and control at the control rate.
+// the autonomy pipeline behind the HAL: the AS state machine, the mission
+// logic of each event, the cone map, planning and control at the control rate.
 #include <deque>
 #include <optional>
 #include <string>
@@ -11,20 +11,22 @@
 #include "autonomy/common/trajectory.h"
 #include "autonomy/control/controller.h"
 #include "autonomy/hal/hal.h"
-#include "autonomy/planning/reference.h"
+#include "autonomy/planning/path_planner.h"
+#include "autonomy/planning/skidpad.h"
 #include "autonomy/slam/cone_map.h"
+#include "autonomy/stack/gates.h"
 
 namespace paddock::stack {
 
 // where each layer's input comes from (the scenario's [autonomy] section)
 enum class PerceptionMode { GroundTruth };
 enum class SlamMode { GroundTruth };
-enum class PlannerMode { Oracle };
+enum class PlannerMode { Oracle, Delaunay };
 
 struct AutonomyModes {
   PerceptionMode perception = PerceptionMode::GroundTruth;
   SlamMode slam = SlamMode::GroundTruth;
-  PlannerMode planner = PlannerMode::Oracle;
+  PlannerMode planner = PlannerMode::Delaunay;
 };
 
 // the dynamic events of the FS rules, as selected on the car's mission switch
@@ -34,24 +36,52 @@ struct MissionParams {
   double stop_decel = 8.0;         // deceleration of the stop after the finish (m/s^2), the planner's braking limit
   double standstill_speed = 0.05;  // below this the car counts as stopped (m/s)
   double state_timeout = 0.2;      // a state estimate older than this triggers the safe stop (s)
+  // the least start speed of a planned profile (m/s): a car at rest needs a
+  // reference above zero to start on
+  double launch_speed = 2.0;
+  // trackdrive: a closed centreline found after at least this much driving is
+  // the lap, planned once and driven from then on (m); earlier closures are
+  // the search cutting across a map that is still being explored
+  double loop_closure_distance = 100.0;
+  // a timekeeping gate is learned from big orange cones seen at least this
+  // often (-) whose gate's middle lies this close to the planned path (m):
+  // a ghost cone of perception must not become a finish line
+  int gate_min_observations = 5;
+  double gate_max_offset = 2.0;
+  // gate crossings closer together than this count once (m): a line marked
+  // by two rows of big orange cones is one line
+  double gate_refractory_distance = 10.0;
+  // acceleration: the straight is planned this far from the start (m): 75 m
+  // to the finish and the braking zone after it
+  double acceleration_length = 150.0;
+  // skidpad: the rules' start position, the car's base this far before the
+  // timekeeping line at the crossing (m); the first guess of the alignment
+  double skidpad_crossing_ahead = 16.5;
+  // skidpad: mapped cones needed before the layout is aligned (-)
+  int skidpad_min_cones = 20;
 };
 
 struct StackParams {
   AutonomyModes modes;
-  planning::ReferenceParams reference;
+  planning::PathPlannerParams planner;   // its reference params serve the oracle mode too
+  planning::SkidpadParams skidpad;
   control::ControlParams control;
   control::VehicleKnowledge vehicle;
   MissionParams mission;
   slam::ConeMapParams cone_map;
+  GateParams gates;
 };
 
 // what the car is told before the start
 struct MissionSpec {
   Mission mission = Mission::Trackdrive;
-  // crossings of the finish line after which the car stops (trackdrive: 11, the
-  // first one starts lap 1); 0: drive to the end of an open path and stop there
+  // gate crossings after which the car stops (trackdrive: 11, the first one
+  // starts lap 1; acceleration: 2, the start and the finish gate); 0: drive to
+  // the end of an open path and stop there (skidpad)
   int finish_crossings = 0;
-  std::optional<Segment> finish_line;  // {left post, right post}; forward crosses right to left
+  // timekeeping gates known in advance {left post, right post} (forward crosses
+  // right to left); planner = delaunay learns them from big orange cones
+  std::vector<Segment> gates;
   // planner = oracle: the reference path (a centreline) known in advance
   std::vector<Vec2> oracle_path;
   bool oracle_closed = false;
@@ -62,29 +92,41 @@ struct Telemetry {
   hal::AsState as_state = hal::AsState::Off;
   control::Diagnostics control;
   bool control_ok = true;
-  int finish_crossings = 0;   // finish-line crossings counted by the stack
+  int finish_crossings = 0;   // gate crossings counted by the stack
   bool stopping = false;      // the mission is over and the car brakes to a stop
   int fallbacks = 0;          // control cycles that ran the safe stop instead of the plan
   std::string last_fault;     // the reason of the last fallback or planning failure
   int mapped_cones = 0;       // cones in the stack's map (seen often enough)
+  int plans = 0;              // planning cycles run
+  int plan_failures = 0;      // planning cycles that kept the previous trajectory
+  bool lap_locked = false;    // the full closed lap is planned and driven
 };
 
 class Stack {
  public:
   Stack(const StackParams& params, MissionSpec spec);
 
-  // drains the HAL's messages, runs one control cycle, sends one command
+  // drains the HAL's messages, plans when there is news, runs one control
+  // cycle, sends one command
   void tick(TimeNs now, hal::Hal& hal);
 
   const Telemetry& telemetry() const { return telemetry_; }
   const Trajectory& trajectory() const { return trajectory_; }
   const slam::ConeMap& cone_map() const { return cone_map_; }
+  // the last planning cycle's result (planner = delaunay), for plots
+  const planning::PlanResult& last_plan() const { return last_plan_; }
+  const std::vector<Segment>& gates() const { return gates_; }
 
  private:
   void on_message(const hal::SensorMessage& m);
   void on_detections(const hal::ConeDetections& d);
   // the base pose at time t from the recent state estimates (interpolated), if known
   std::optional<Pose2> pose_at(TimeNs t) const;
+  // planner = delaunay: a new plan from the cone map when the map has news
+  void plan(const hal::StateEstimate& st);
+  void learn_gates(const Pose2& pose);
+  void count_crossings(Vec2 base, TimeNs now, double speed);
+  void start_stopping(TimeNs now, double speed);
   hal::ActuatorCommand safe_stop(TimeNs now, const std::string& reason);
 
   StackParams params_;
@@ -96,7 +138,12 @@ class Stack {
   std::optional<hal::StateEstimate> state_;
   std::deque<hal::StateEstimate> history_;  // the last second of state estimates, oldest first
   slam::ConeMap cone_map_;
-  std::optional<Vec2> last_base_position_;  // for the finish-line crossing test
+  bool map_news_ = false;                   // detections since the last plan
+  planning::PlanResult last_plan_;
+  std::vector<Segment> gates_;              // known and learned timekeeping gates
+  std::optional<Vec2> last_base_position_;  // for the gate crossing test
+  double driven_ = 0.0;                     // distance driven (m)
+  double last_crossing_at_ = -1e9;          // driven_ at the last counted crossing (m)
   bool go_ = false;
   bool emergency_ = false;
   std::optional<TimeNs> last_tick_;

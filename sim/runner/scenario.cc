@@ -215,7 +215,7 @@ std::vector<Field> build_fields() {
   f.push_back(enum_field<SlamMode>("autonomy", "slam", "where the pose comes from", {{"ground_truth", SlamMode::GroundTruth}},
                                    ACC(autonomy.slam)));
   f.push_back(enum_field<PlannerMode>("autonomy", "planner", "where the reference path comes from",
-                                      {{"oracle", PlannerMode::Oracle}}, ACC(autonomy.planner)));
+                                      {{"delaunay", PlannerMode::Delaunay}, {"oracle", PlannerMode::Oracle}}, ACC(autonomy.planner)));
 
   // [control]
   using control::LateralMode;
@@ -249,17 +249,17 @@ std::vector<Field> build_fields() {
 
   // [planning]
   f.push_back(real_field("planning", "knot_spacing", "m", 0.1, 50.0, "spline knot spacing along the centreline",
-                         ACC(planning.knot_spacing)));
-  f.push_back(real_field("planning", "ds", "m", 0.01, 10.0, "trajectory sample spacing", ACC(planning.ds)));
-  f.push_back(real_field("planning", "ax_max", "m/s^2", 0.1, 100.0, "tyre acceleration limit of the profile", ACC(planning.profile.ax_max)));
-  f.push_back(real_field("planning", "ay_max", "m/s^2", 0.1, 100.0, "tyre lateral limit of the profile", ACC(planning.profile.ay_max)));
+                         ACC(planning.reference.knot_spacing)));
+  f.push_back(real_field("planning", "ds", "m", 0.01, 10.0, "trajectory sample spacing", ACC(planning.reference.ds)));
+  f.push_back(real_field("planning", "ax_max", "m/s^2", 0.1, 100.0, "tyre acceleration limit of the profile", ACC(planning.reference.profile.ax_max)));
+  f.push_back(real_field("planning", "ay_max", "m/s^2", 0.1, 100.0, "tyre lateral limit of the profile", ACC(planning.reference.profile.ay_max)));
   f.push_back(real_field("planning", "ax_brake_max", "m/s^2", 0.1, 100.0, "tyre deceleration limit of the profile",
-                         ACC(planning.profile.ax_brake_max)));
-  f.push_back(real_field("planning", "exponent", "", 1.0, 10.0, "g-g diagram exponent p", ACC(planning.profile.exponent)));
-  f.push_back(real_field("planning", "ax_machine", "m/s^2", 0.1, 100.0, "motor acceleration limit", ACC(planning.profile.ax_machine)));
-  f.push_back(real_field("planning", "v_max", "m/s", 0.1, 100.0, "top speed of the profile", ACC(planning.profile.v_max)));
+                         ACC(planning.reference.profile.ax_brake_max)));
+  f.push_back(real_field("planning", "exponent", "", 1.0, 10.0, "g-g diagram exponent p", ACC(planning.reference.profile.exponent)));
+  f.push_back(real_field("planning", "ax_machine", "m/s^2", 0.1, 100.0, "motor acceleration limit", ACC(planning.reference.profile.ax_machine)));
+  f.push_back(real_field("planning", "v_max", "m/s", 0.1, 100.0, "top speed of the profile", ACC(planning.reference.profile.v_max)));
   f.push_back(real_field("planning", "turn_accel_scale", "", 0.0, 1.0, "longitudinal limits kept in a full-grip turn",
-                         ACC(planning.profile.turn_accel_scale)));
+                         ACC(planning.reference.profile.turn_accel_scale)));
 
   // [mission]
   f.push_back(real_field("mission", "stop_decel", "m/s^2", 0.1, 50.0, "deceleration of the stop after the finish", ACC(mission.stop_decel)));
@@ -465,9 +465,12 @@ stack::StackParams stack_params(const Scenario& s) {
   k.max_brake_force = v.brake_force_max;
   k.drag_coefficient = v.c_drag;
   k.rolling_resistance = v.cr0;
-  p.reference = s.planning;
-  p.reference.profile.mass = v.mass;
-  p.reference.profile.drag_coefficient = v.c_drag;
+  p.planner = s.planning;
+  p.planner.reference.profile.mass = v.mass;
+  p.planner.reference.profile.drag_coefficient = v.c_drag;
+  // the skidpad's reference uses the same planned limits
+  p.skidpad = s.skidpad;
+  p.skidpad.reference = p.planner.reference;
   return p;
 }
 

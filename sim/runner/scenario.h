@@ -57,7 +57,8 @@ struct Scenario {
   sensors::ConeSensorParams perception;  // the cone sensor of perception = ground_truth
   vehicle::VehicleParams vehicle;
   control::ControlParams control;
-  planning::ReferenceParams planning;
+  planning::PathPlannerParams planning;
+  planning::SkidpadParams skidpad;
   stack::MissionParams mission;
   world::ConeWorldParams cones;
   events::EventParams event;

@@ -46,32 +46,36 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-stack::MissionSpec mission_for(events::EventKind kind, const world::TrackModel& track) {
+stack::MissionSpec mission_for(events::EventKind kind, const world::TrackModel& track, stack::PlannerMode planner) {
   stack::MissionSpec m;
   const events::Rules rules = events::rules_for(kind);
+  const bool oracle = planner == stack::PlannerMode::Oracle;
   switch (kind) {
     case events::EventKind::Trackdrive:
     case events::EventKind::Autocross:
-      m.mission = kind == events::EventKind::Trackdrive ? stack::Mission::Trackdrive : stack::Mission::Autocross;
-      m.oracle_path = track.centreline;
-      m.oracle_closed = track.closed;
       // the first crossing starts lap 1, so the finish is one more
-      if (!track.gates.empty()) m.finish_line = track.gates.front();
+      m.mission = kind == events::EventKind::Trackdrive ? stack::Mission::Trackdrive : stack::Mission::Autocross;
       m.finish_crossings = rules.laps + 1;
+      if (oracle) {
+        m.oracle_path = track.centreline;
+        m.oracle_closed = track.closed;
+        if (!track.gates.empty()) m.gates = {track.gates.front()};
+      }
       break;
     case events::EventKind::Acceleration:
+      // the start gate, then the finish gate 75 m on
       m.mission = stack::Mission::Acceleration;
-      m.oracle_path = track.centreline;
-      m.oracle_closed = false;
-      if (track.gates.size() >= 2) m.finish_line = track.gates[1];
-      m.finish_crossings = 1;
+      m.finish_crossings = 2;
+      if (oracle) {
+        m.oracle_path = track.centreline;
+        m.gates = track.gates;
+      }
       break;
     case events::EventKind::Skidpad:
-      // the path ends at rest in the exit lane; no finish-line counting
+      // the path ends at rest in the exit lane; no gates to count
       m.mission = stack::Mission::Skidpad;
-      if (track.skidpad) m.oracle_path = skidpad_path(*track.skidpad);
-      m.oracle_closed = false;
       m.finish_crossings = 0;
+      if (oracle && track.skidpad) m.oracle_path = skidpad_path(*track.skidpad);
       break;
   }
   return m;
@@ -122,7 +126,7 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   vehicle::VehicleState car = vehicle::initial_state(vp, start_pose(track, footprint.x_max));
   world::ConeWorld cones(event_cones(track), sc.cones, world::Footprint{-footprint.x_min, footprint.x_max, footprint.y_max});
   events::Event event(sc.scenario.event, track, sc.event);
-  stack::Stack stack(stack_params(sc), mission_for(sc.scenario.event, track));
+  stack::Stack stack(stack_params(sc), mission_for(sc.scenario.event, track, sc.autonomy.planner));
   SimHal hal;
 
   // perception = ground_truth: the object-level cone sensor, on its own random

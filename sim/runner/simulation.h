@@ -66,9 +66,9 @@ struct RunResult {
   int cycles = 0;          // control cycles run
 };
 
-// the mission the car is given for an event on a track (planner = oracle: the
-// ground-truth path of the event)
-stack::MissionSpec mission_for(events::EventKind kind, const world::TrackModel& track);
+// the mission the car is given for an event on a track (planner = oracle: also
+// the ground-truth path of the event and its timekeeping gates)
+stack::MissionSpec mission_for(events::EventKind kind, const world::TrackModel& track, stack::PlannerMode planner);
 
 // the cones standing at the event: the track's, plus a big orange cone at
 // each timekeeping post when the file has no big orange cones at all (the

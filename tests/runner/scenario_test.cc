@@ -88,7 +88,7 @@ TEST_F(ScenarioFile, UnitsConvertToSI) {
   const auto p = write(std::string(kHead) + "[vehicle]\nsteering_max = 30 deg\n[planning]\nv_max = 72 km/h\n");
   const Scenario s = load_scenario(p);
   EXPECT_NEAR(s.vehicle.steering_max, 30.0 * M_PI / 180.0, 1e-15);
-  EXPECT_NEAR(s.planning.profile.v_max, 20.0, 1e-12);
+  EXPECT_NEAR(s.planning.reference.profile.v_max, 20.0, 1e-12);
 }
 
 TEST_F(ScenarioFile, MissingVehicleKeysAreNamed) {

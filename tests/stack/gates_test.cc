@@ -35,7 +35,7 @@ TEST(Gates, AccelerationLayoutGivesTwoGates) {
 TEST(Gates, TooNarrowOrTooWideOrLonelyPostsMakeNoGate) {
   EXPECT_TRUE(find_gates({{{0, 0}, ConeColor::BigOrange}}).empty());
   EXPECT_TRUE(find_gates({{{0, 0}, ConeColor::BigOrange}, {{0, 1.5}, ConeColor::BigOrange}}).empty());
-  EXPECT_TRUE(find_gates({{{0, 0}, ConeColor::BigOrange}, {{0, 20}, ConeColor::BigOrange}}).empty());
+  EXPECT_TRUE(find_gates({{{0, 0}, ConeColor::BigOrange}, {{0, 25}, ConeColor::BigOrange}}).empty());
   EXPECT_TRUE(find_gates({}).empty());
   // a circuit's posts 8 m apart across the start straight
   const auto g = find_gates({{{7.68, 4.0}, ConeColor::BigOrange}, {{7.68, -4.0}, ConeColor::BigOrange}});

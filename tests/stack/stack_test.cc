@@ -36,9 +36,16 @@ MissionSpec circle_mission(int crossings) {
   m.mission = Mission::Trackdrive;
   m.oracle_path = circle(20.0, 72);  // counter-clockwise from (0, 0) heading +x
   m.oracle_closed = true;
-  m.finish_line = Segment{{5.0, 3.0}, {5.0, -3.0}};
+  m.gates = {Segment{{5.0, 3.0}, {5.0, -3.0}}};
   m.finish_crossings = crossings;
   return m;
+}
+
+// these tests drive the oracle planner: the path is given
+StackParams oracle_params() {
+  StackParams p;
+  p.modes.planner = PlannerMode::Oracle;
+  return p;
 }
 
 hal::StateEstimate state_at(TimeNs t, Vec2 p, double yaw, double v) {
@@ -46,7 +53,7 @@ hal::StateEstimate state_at(TimeNs t, Vec2 p, double yaw, double v) {
 }
 
 TEST(Stack, WaitsInReadyWithBrakesOnUntilGo) {
-  Stack s(StackParams{}, circle_mission(2));
+  Stack s(oracle_params(), circle_mission(2));
   ScriptedHal hal;
   s.tick(0, hal);  // no state yet: off
   EXPECT_EQ(hal.sent.back().as_state, hal::AsState::Off);
@@ -66,7 +73,7 @@ TEST(Stack, WaitsInReadyWithBrakesOnUntilGo) {
 }
 
 TEST(Stack, EmergencyFromAnyState) {
-  Stack s(StackParams{}, circle_mission(2));
+  Stack s(oracle_params(), circle_mission(2));
   ScriptedHal hal;
   hal.inbox.push_back(state_at(0, {0, 0}, 0.0, 0.0));
   hal.inbox.push_back(hal::ResSignal{0, true, false});
@@ -79,7 +86,7 @@ TEST(Stack, EmergencyFromAnyState) {
 }
 
 TEST(Stack, StaleStateGivesTheSafeStopAndCountsIt) {
-  Stack s(StackParams{}, circle_mission(2));
+  Stack s(oracle_params(), circle_mission(2));
   ScriptedHal hal;
   hal.inbox.push_back(state_at(0, {0, 0}, 0.0, 5.0));
   hal.inbox.push_back(hal::ResSignal{0, true, false});
@@ -95,7 +102,7 @@ TEST(Stack, StaleStateGivesTheSafeStopAndCountsIt) {
 TEST(Stack, BadPlanInputLeavesTheCarParkedWithAReason) {
   MissionSpec m = circle_mission(2);
   m.oracle_path = {{0.0, 0.0}};  // one point: no path
-  Stack s(StackParams{}, m);
+  Stack s(oracle_params(), m);
   ScriptedHal hal;
   hal.inbox.push_back(state_at(0, {0, 0}, 0.0, 0.0));
   hal.inbox.push_back(hal::ResSignal{0, true, false});
@@ -108,7 +115,7 @@ TEST(Stack, BadPlanInputLeavesTheCarParkedWithAReason) {
 // a kinematic car drives the stack's commands around the circle: it must count
 // its crossings of the finish line, brake after the last one, stop, and finish
 TEST(Stack, CountsFinishCrossingsThenStopsAndFinishes) {
-  StackParams p;
+  const StackParams p = oracle_params();
   Stack s(p, circle_mission(3));  // start line, then two laps
   ScriptedHal hal;
   double x = -2.0, y = 0.0, yaw = 0.0, v = 0.0, delta = 0.0;

@@ -1,0 +1,496 @@
+#include "autonomy/planning/centreline.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+#include <cstdio>
+#include <cstdlib>
+
+namespace paddock::planning {
+
+namespace {
+
+bool finite(double v) { return std::isfinite(v); }
+
+// 2 exp(-(x/sigma)^2 / 2) - 1: 1 at x = 0, -1 far away
+double bell(double x, double sigma) {
+  const double r = x / sigma;
+  return 2.0 * std::exp(-0.5 * r * r) - 1.0;
+}
+
+// what the colours of an edge's two cones say, before the direction is known
+enum class EdgeColour : std::uint8_t {
+  Pair,     // one blue, one yellow: +1 when blue is on the left, -1 when not
+  Same,     // blue-blue or yellow-yellow: a boundary, -1
+  Neutral,  // at most one of them blue or yellow: 0
+};
+
+// what the search needs of an edge, computed once
+struct EdgeInfo {
+  Vec2 mid;
+  Vec2 a;              // position of cone a (the blue one of a Pair is known by blue_is_a)
+  Vec2 dir;            // unit vector from cone a to cone b
+  double length = 0.0;  // distance between the cones (m)
+  EdgeColour colour = EdgeColour::Neutral;
+  bool blue_is_a = false;
+};
+
+// a state of the search: where it stands and how it got there
+struct Node {
+  Vec2 p;                      // current point (m)
+  Vec2 dir{1.0, 0.0};          // unit direction of the last step
+  double step = 0.0;           // length of the last step (m)
+  double turn = 0.0;           // predicted heading change of the next step (rad)
+  double last_turn = 0.0;      // heading change of the last step (rad)
+  std::size_t edge = kNoCone;  // the edge of the current point, none at the vehicle
+};
+
+// one scored candidate
+struct Candidate {
+  std::size_t edge = 0;
+  double reward = 0.0;
+  RewardTerms terms;
+  Node next;
+  bool closes = false;  // steps back onto one of the first points: the lap closes
+  int target = -1;      // which of the first points, when it closes
+};
+
+// the few edges of the branch being looked ahead (depth <= kMaxDepth)
+constexpr int kMaxDepth = 8;
+constexpr int kMaxBeam = 16;
+struct Branch {
+  std::array<std::size_t, kMaxDepth> edges{};
+  int size = 0;
+  bool contains(std::size_t e) const {
+    for (int i = 0; i < size; ++i)
+      if (edges[static_cast<std::size_t>(i)] == e) return true;
+    return false;
+  }
+};
+
+class Search {
+ public:
+  Search(const Triangulation& tri, const std::vector<Cone>& cones, const CentrelineParams& p)
+      : p_(p) {
+    const double wsum = p.weight_colour + p.weight_width + p.weight_angle + p.weight_step +
+                        p.weight_prediction + p.weight_crossing;
+    inv_weight_sum_ = 1.0 / wsum;
+    cos_max_turn_ = std::cos(p.max_turn);
+    // what each edge brings by itself
+    info_.resize(tri.edges.size());
+    for (std::size_t i = 0; i < tri.edges.size(); ++i) {
+      const TriEdge& e = tri.edges[i];
+      EdgeInfo& in = info_[i];
+      in.mid = e.midpoint;
+      in.a = cones[e.a].position;
+      const Vec2 ab = cones[e.b].position - in.a;
+      in.dir = e.length > 0.0 ? ab / e.length : Vec2{1.0, 0.0};
+      in.length = e.length;
+      const ConeColor ca = cones[e.a].color, cb = cones[e.b].color;
+      const bool a_by = ca == ConeColor::Blue || ca == ConeColor::Yellow;
+      const bool b_by = cb == ConeColor::Blue || cb == ConeColor::Yellow;
+      if (a_by && b_by) {
+        in.colour = ca == cb ? EdgeColour::Same : EdgeColour::Pair;
+        in.blue_is_a = ca == ConeColor::Blue;
+      }
+    }
+    build_neighbours();
+    used_.assign(info_.size(), 0);
+    buffers_.resize(static_cast<std::size_t>(p.horizon_depth) + 1);
+  }
+
+  CentrelineResult run(const Pose2& start) {
+    CentrelineResult out;
+    Node cur;
+    cur.p = start.position();
+    cur.dir = start.heading();
+    cur.step = p_.step_preferred;
+    cur.turn = 0.0;
+    double length = 0.0;  // along the committed points (m)
+    std::vector<Vec2> arrival;  // the direction of the step onto each point
+
+    while (true) {
+      if (static_cast<int>(out.points.size()) >= p_.max_points) {
+        out.stop = CentrelineStop::MaxPoints;
+        break;
+      }
+      if (length >= p_.max_length) {
+        out.stop = CentrelineStop::MaxLength;
+        break;
+      }
+      // every candidate above the threshold, each valued over the horizon
+      closure_ok_ = out.points.size() > static_cast<std::size_t>(p_.closure_points);
+      path_length_ = length;
+      first_points_ = &out.steps;
+      arrival_ = &arrival;
+      std::vector<Candidate>& cands = buffers_[0];
+      Branch branch;
+      collect(cur, branch, false, cands);
+      if (cands.empty() && std::getenv("CL_DEBUG")) {
+        for (std::size_t j = 0; j < info_.size(); ++j) {
+          Candidate c;
+          if (!score(cur, j, c)) continue;
+          std::fprintf(stderr, "cand %zu mid (%.2f,%.2f) used %d r %.3f col %.2f w %.2f ang %.2f step %.2f pred %.2f cross %.2f\n", j, c.next.p.x, c.next.p.y, used_[j], c.reward, c.terms.colour, c.terms.width, c.terms.angle, c.terms.step, c.terms.prediction, c.terms.crossing);
+        }
+      }
+      if (cands.empty()) {
+        out.stop = CentrelineStop::NoCandidate;
+        break;
+      }
+      std::size_t best = 0;
+      double best_value = -1.0;
+      for (std::size_t k = 0; k < cands.size(); ++k) {
+        const Candidate& c = cands[k];
+        double v = c.reward;
+        if (c.closes) {
+          v += c.reward * (p_.horizon_depth - 1);
+        } else {
+          branch.edges[0] = c.edge;
+          branch.size = 1;
+          v += lookahead(c.next, p_.horizon_depth - 1, branch);
+        }
+        // cands is sorted best reward first, so ties keep the better step
+        if (v > best_value + 1e-12) {
+          best_value = v;
+          best = k;
+        }
+      }
+      const Candidate chosen = cands[best];
+      const int ncands = static_cast<int>(cands.size());
+      if (chosen.closes) {
+        // the lap: from the point it steps back onto to the current one
+        const std::size_t j = static_cast<std::size_t>(chosen.target);
+        out.points.erase(out.points.begin(), out.points.begin() + static_cast<std::ptrdiff_t>(j));
+        out.steps.erase(out.steps.begin(), out.steps.begin() + static_cast<std::ptrdiff_t>(j));
+        out.closed = true;
+        out.stop = CentrelineStop::LoopClosed;
+        break;
+      }
+      CentrelineStep st;
+      st.edge = chosen.edge;
+      st.point = chosen.next.p;
+      st.terms = chosen.terms;
+      st.reward = chosen.reward;
+      st.horizon_reward = best_value;
+      st.candidates = ncands;
+      if (!out.points.empty()) length += distance(out.points.back(), st.point);
+      out.points.push_back(st.point);
+      out.steps.push_back(st);
+      arrival.push_back(chosen.next.dir);
+      used_[chosen.edge] = 1;
+      cur = chosen.next;
+    }
+
+    // the length along the points, with the closing step of a lap
+    out.length = 0.0;
+    for (std::size_t i = 1; i < out.points.size(); ++i)
+      out.length += distance(out.points[i - 1], out.points[i]);
+    if (out.closed && out.points.size() > 1)
+      out.length += distance(out.points.back(), out.points.front());
+    if (out.points.size() < 2 || (out.closed && out.points.size() < 3)) {
+      out.status = CentrelineStatus::NoPath;
+      out.reason = "centreline: the search found " + std::to_string(out.points.size()) +
+                   " point(s) ahead of the vehicle (" + to_string(out.stop) + ")";
+      out.closed = false;
+      return out;
+    }
+    out.status = CentrelineStatus::Ok;
+    return out;
+  }
+
+ private:
+  // the edges whose midpoints lie within the search radius of each edge's
+  // midpoint (CSR lists), by sorting the midpoints into square cells
+  void build_neighbours() {
+    const std::size_t n = info_.size();
+    const double cell = p_.search_radius;
+    const double r2 = p_.search_radius * p_.search_radius;
+    // cell coordinates, clamped so that far-away cones cannot overflow
+    auto cell_of = [&](double v) {
+      const double c = std::floor(v / cell);
+      return static_cast<std::int64_t>(std::clamp(c, -1e15, 1e15));
+    };
+    std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::size_t>> keyed(n);
+    for (std::size_t i = 0; i < n; ++i)
+      keyed[i] = {{cell_of(info_[i].mid.x), cell_of(info_[i].mid.y)}, i};
+    std::sort(keyed.begin(), keyed.end());
+    nb_begin_.assign(n + 1, 0);
+    std::vector<std::vector<std::size_t>> lists(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto key = std::make_pair(cell_of(info_[i].mid.x), cell_of(info_[i].mid.y));
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        const auto lo = std::make_pair(std::make_pair(key.first + dx, key.second - 1), std::size_t{0});
+        const auto hi = std::make_pair(std::make_pair(key.first + dx, key.second + 1), n);
+        auto it = std::lower_bound(keyed.begin(), keyed.end(), lo);
+        const auto end = std::upper_bound(keyed.begin(), keyed.end(), hi);
+        for (; it != end; ++it) {
+          const std::size_t j = it->second;
+          if (j != i && squared_norm(info_[j].mid - info_[i].mid) <= r2) lists[i].push_back(j);
+        }
+      }
+      std::sort(lists[i].begin(), lists[i].end());
+    }
+    for (std::size_t i = 0; i < n; ++i) nb_begin_[i + 1] = nb_begin_[i] + lists[i].size();
+    nb_.resize(nb_begin_[n]);
+    for (std::size_t i = 0; i < n; ++i)
+      std::copy(lists[i].begin(), lists[i].end(), nb_.begin() + static_cast<std::ptrdiff_t>(nb_begin_[i]));
+  }
+
+  // the reward of stepping from s onto edge c's midpoint; false when the
+  // midpoint is not a candidate (too near, too far, outside the forward cone)
+  bool score(const Node& s, std::size_t c, Candidate& out) const {
+    const EdgeInfo& e = info_[c];
+    const Vec2 d = e.mid - s.p;
+    const double l2 = squared_norm(d);
+    if (l2 < p_.min_step * p_.min_step || l2 > p_.search_radius * p_.search_radius) return false;
+    const double l = std::sqrt(l2);
+    const double along = dot(s.dir, d);
+    if (along < cos_max_turn_ * l) return false;
+    const double across = cross(s.dir, d);
+    const Vec2 u = d / l;
+    RewardTerms t;
+    // colour: blue on the left and yellow on the right of the step
+    switch (e.colour) {
+      case EdgeColour::Pair: {
+        const bool a_left = cross(u, e.a - e.mid) > 0.0;
+        t.colour = a_left == e.blue_is_a ? 1.0 : -1.0;
+        break;
+      }
+      case EdgeColour::Same: t.colour = -1.0; break;
+      case EdgeColour::Neutral: t.colour = 0.0; break;
+    }
+    // the track width: the edge's extent across the direction of travel (a
+    // diagonal rung between staggered cones is longer than the track is wide)
+    t.width = track_width_reward(e.length * std::abs(cross(u, e.dir)), p_);
+    const double turn = std::atan2(across, along);
+    t.angle = bell(turn, p_.angle_sigma);
+    t.step = bell(l - p_.step_preferred, p_.step_sigma);
+    // the prediction: the heading turned as much again as over the last two
+    // steps on average (the midpoints zig-zag), at this candidate's distance
+    const Vec2 predicted = s.p + rotate(s.dir, s.turn) * l;
+    t.prediction = bell(distance(e.mid, predicted), p_.prediction_sigma);
+    // a track crossing (rung) is crossed squarely, a boundary edge lengthwise
+    t.crossing = 2.0 * std::abs(cross(u, e.dir)) - 1.0;
+    out.edge = c;
+    out.terms = t;
+    out.reward = (p_.weight_colour * t.colour + p_.weight_width * t.width +
+                  p_.weight_angle * t.angle + p_.weight_step * t.step +
+                  p_.weight_prediction * t.prediction + p_.weight_crossing * t.crossing) *
+                 inv_weight_sum_;
+    out.next.p = e.mid;
+    out.next.dir = u;
+    out.next.step = l;
+    out.next.turn = 0.5 * (turn + s.last_turn);
+    out.next.last_turn = turn;
+    out.next.edge = c;
+    out.closes = false;
+    out.target = -1;
+    return true;
+  }
+
+  // the candidates from s above min_reward, best first; inside the
+  // look-ahead (`beam`) only the best beam_width of them
+  void collect(const Node& s, const Branch& branch, bool beam, std::vector<Candidate>& out) const {
+    out.clear();
+    Candidate c;
+    auto consider = [&](std::size_t j) {
+      if (j == s.edge || branch.contains(j)) return;
+      int target = -1;
+      if (used_[j]) {
+        // a used edge is taken again only to close the lap
+        if (!closure_ok_ || path_length_ < p_.closure_min_length) return;
+        for (int k = 0; k < p_.closure_points; ++k)
+          if ((*first_points_)[static_cast<std::size_t>(k)].edge == j) target = k;
+        if (target < 0) return;
+      }
+      if (!score(s, j, c) || !(c.reward >= p_.min_reward)) return;
+      if (target >= 0) {
+        // ... heading the way the path first went through that point
+        const Vec2 first = (*arrival_)[static_cast<std::size_t>(target)];
+        if (dot(first, c.next.dir) < std::cos(p_.closure_max_angle)) return;
+        c.closes = true;
+        c.target = target;
+      }
+      out.push_back(c);
+    };
+    if (s.edge == kNoCone) {
+      for (std::size_t j = 0; j < info_.size(); ++j) consider(j);
+    } else {
+      for (std::size_t k = nb_begin_[s.edge]; k < nb_begin_[s.edge + 1]; ++k) consider(nb_[k]);
+    }
+    // best first; ties by edge index so the order never depends on the sort
+    std::sort(out.begin(), out.end(), [](const Candidate& x, const Candidate& y) {
+      return x.reward > y.reward || (x.reward == y.reward && x.edge < y.edge);
+    });
+    if (beam && out.size() > static_cast<std::size_t>(p_.beam_width))
+      out.resize(static_cast<std::size_t>(p_.beam_width));
+  }
+
+  // the best cumulative reward of up to `depth` more steps from s; a dead
+  // end scores 0 for each step it misses, and a closing step counts as if
+  // the lap went on equally well
+  double lookahead(const Node& s, int depth, Branch& branch) {
+    if (depth <= 0) return 0.0;
+    std::vector<Candidate>& cands = buffers_[static_cast<std::size_t>(branch.size)];
+    collect(s, branch, true, cands);
+    double best = 0.0;
+    for (std::size_t k = 0; k < cands.size(); ++k) {
+      const Candidate c = cands[k];  // a copy: deeper levels reuse other buffers only
+      double v = c.reward;
+      if (c.closes) {
+        v += c.reward * (depth - 1);
+      } else {
+        branch.edges[static_cast<std::size_t>(branch.size++)] = c.edge;
+        v += lookahead(c.next, depth - 1, branch);
+        --branch.size;
+      }
+      best = std::max(best, v);
+    }
+    return best;
+  }
+
+  const CentrelineParams& p_;
+  std::vector<EdgeInfo> info_;
+  std::vector<std::size_t> nb_begin_, nb_;
+  std::vector<char> used_;
+  std::vector<std::vector<Candidate>> buffers_;  // one per look-ahead level
+  double inv_weight_sum_ = 1.0;
+  double cos_max_turn_ = 0.0;
+  // the committed path, as the candidates of one step see it
+  bool closure_ok_ = false;
+  double path_length_ = 0.0;
+  const std::vector<CentrelineStep>* first_points_ = nullptr;
+  const std::vector<Vec2>* arrival_ = nullptr;
+};
+
+bool all_finite_nonneg(std::initializer_list<double> v) {
+  for (double x : v)
+    if (!(finite(x) && x >= 0.0)) return false;
+  return true;
+}
+
+}  // namespace
+
+double track_width_reward(double w, const CentrelineParams& p) {
+  if (w < p.width_min) {
+    const double r = (w - p.width_min) / p.width_sigma;
+    return 1.3 * std::exp(-0.5 * r * r) - 0.3;
+  }
+  if (w > p.width_max) {
+    const double r = (w - p.width_max) / p.width_sigma;
+    return 1.3 * std::exp(-0.5 * r * r) - 0.3;
+  }
+  return 1.0;
+}
+
+std::optional<std::string> validate(const CentrelineParams& p) {
+  if (!(finite(p.search_radius) && p.search_radius > 0.0))
+    return "search_radius must be a positive length (m)";
+  if (!(finite(p.min_step) && p.min_step >= 0.0 && p.min_step < p.search_radius))
+    return "min_step must be a length (m) in [0, search_radius)";
+  if (!(finite(p.max_turn) && p.max_turn > 0.0 && p.max_turn < kPi))
+    return "max_turn must be an angle (rad) in (0, pi)";
+  if (!all_finite_nonneg({p.weight_colour, p.weight_width, p.weight_angle, p.weight_step,
+                          p.weight_prediction, p.weight_crossing}))
+    return "the weights must be finite and >= 0";
+  if (!(p.weight_colour + p.weight_width + p.weight_angle + p.weight_step + p.weight_prediction +
+            p.weight_crossing > 0.0))
+    return "at least one weight must be > 0";
+  if (!(finite(p.width_min) && finite(p.width_max) && p.width_min >= 0.0 &&
+        p.width_min <= p.width_max))
+    return "width_min and width_max must be lengths (m) with width_min <= width_max";
+  if (!(finite(p.width_sigma) && p.width_sigma > 0.0)) return "width_sigma must be > 0 (m)";
+  if (!(finite(p.angle_sigma) && p.angle_sigma > 0.0)) return "angle_sigma must be > 0 (rad)";
+  if (!(finite(p.step_preferred) && p.step_preferred >= 0.0))
+    return "step_preferred must be a length (m) >= 0";
+  if (!(finite(p.step_sigma) && p.step_sigma > 0.0)) return "step_sigma must be > 0 (m)";
+  if (!(finite(p.prediction_sigma) && p.prediction_sigma > 0.0))
+    return "prediction_sigma must be > 0 (m)";
+  if (p.horizon_depth < 1 || p.horizon_depth > kMaxDepth)
+    return "horizon_depth must be in [1, " + std::to_string(kMaxDepth) + "]";
+  if (p.beam_width < 1 || p.beam_width > kMaxBeam)
+    return "beam_width must be in [1, " + std::to_string(kMaxBeam) + "]";
+  if (!finite(p.min_reward)) return "min_reward must be finite";
+  if (p.max_points < 2) return "max_points must be >= 2";
+  if (!(p.max_length > 0.0)) return "max_length must be > 0 (m)";
+  if (p.closure_points < 1) return "closure_points must be >= 1";
+  if (!(finite(p.closure_min_length) && p.closure_min_length >= 0.0))
+    return "closure_min_length must be a length (m) >= 0";
+  if (!(finite(p.closure_max_angle) && p.closure_max_angle > 0.0 && p.closure_max_angle <= kPi))
+    return "closure_max_angle must be an angle (rad) in (0, pi]";
+  return std::nullopt;
+}
+
+const char* to_string(CentrelineStatus s) {
+  switch (s) {
+    case CentrelineStatus::Ok: return "ok";
+    case CentrelineStatus::BadParams: return "bad parameters";
+    case CentrelineStatus::BadPose: return "bad start pose";
+    case CentrelineStatus::NoTriangulation: return "no triangulation";
+    case CentrelineStatus::SingleColour: return "single colour";
+    case CentrelineStatus::NoPath: return "no path";
+  }
+  return "?";
+}
+
+const char* to_string(CentrelineStop s) {
+  switch (s) {
+    case CentrelineStop::None: return "not run";
+    case CentrelineStop::NoCandidate: return "no candidate above min_reward";
+    case CentrelineStop::LoopClosed: return "loop closed";
+    case CentrelineStop::MaxPoints: return "max_points reached";
+    case CentrelineStop::MaxLength: return "max_length reached";
+  }
+  return "?";
+}
+
+CentrelineResult search_centreline(const Triangulation& tri, const std::vector<Cone>& cones,
+                                   const Pose2& start, const CentrelineParams& params) {
+  CentrelineResult out;
+  if (auto bad = validate(params)) {
+    out.status = CentrelineStatus::BadParams;
+    out.reason = "centreline: " + *bad;
+    return out;
+  }
+  if (!(finite(start.x) && finite(start.y) && finite(start.yaw))) {
+    out.status = CentrelineStatus::BadPose;
+    out.reason = "centreline: the start pose is not finite";
+    return out;
+  }
+  if (!tri.ok()) {
+    out.status = CentrelineStatus::NoTriangulation;
+    out.reason = "centreline: " + (tri.reason.empty() ? std::string("no triangulation") : tri.reason);
+    return out;
+  }
+  // the triangulation must be of these cones
+  for (const TriEdge& e : tri.edges) {
+    if (e.a >= cones.size() || e.b >= cones.size()) {
+      out.status = CentrelineStatus::NoTriangulation;
+      out.reason = "centreline: the triangulation is not of these cones (index out of range)";
+      return out;
+    }
+  }
+  // one known colour and nothing else: only one boundary was seen
+  std::array<std::size_t, 5> count{};
+  std::size_t finite_cones = 0;
+  for (std::size_t i = 0; i < cones.size(); ++i) {
+    if (i < tri.representative.size() && tri.representative[i] != i) continue;
+    ++count[static_cast<std::size_t>(cones[i].color)];
+    ++finite_cones;
+  }
+  for (ConeColor c : {ConeColor::Blue, ConeColor::Yellow, ConeColor::SmallOrange,
+                      ConeColor::BigOrange}) {
+    if (count[static_cast<std::size_t>(c)] == finite_cones) {
+      out.status = CentrelineStatus::SingleColour;
+      out.reason = "centreline: all " + std::to_string(finite_cones) + " cones are " +
+                   std::string(cone_tag(c)) + ": only one boundary, no track to follow";
+      return out;
+    }
+  }
+  Search search(tri, cones, params);
+  return search.run(start);
+}
+
+}  // namespace paddock::planning

@@ -1,0 +1,188 @@
+#include "autonomy/planning/path_planner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace paddock::planning {
+
+namespace {
+
+bool finite(const Pose2& p) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.yaw);
+}
+
+// points closer than this are one point when the vehicle's position is put
+// in front of the centreline (m)
+constexpr double kSamePoint = 1e-3;
+
+// the steps every planner shares: parameters, input, triangulation, search.
+// False (with out's status and reason set) when there is no centreline.
+bool triangulate_and_search(const std::vector<Cone>& cone_map, const Pose2& vehicle, double speed,
+                            const PathPlannerParams& params, PlanResult& out) {
+  if (auto bad = validate(params)) {
+    out.status = PlanStatus::BadParams;
+    out.reason = "planner: " + *bad;
+    return false;
+  }
+  if (!finite(vehicle) || std::isnan(speed)) {
+    out.status = PlanStatus::BadInput;
+    out.reason = "planner: the vehicle's pose or speed is not finite";
+    return false;
+  }
+  // the triangulation, then the search on it
+  out.triangulation = triangulate(cone_map);
+  if (!out.triangulation.ok()) {
+    out.status = PlanStatus::NoTriangulation;
+    out.reason = "planner: " + out.triangulation.reason;
+    return false;
+  }
+  out.search = search_centreline(out.triangulation, cone_map, vehicle, params.search);
+  if (!out.search.ok()) {
+    out.status = PlanStatus::NoCentreline;
+    out.reason = "planner: " + out.search.reason;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<std::string> validate(const PathPlannerParams& p) {
+  if (auto bad = validate(p.search)) return "search: " + *bad;
+  if (auto bad = validate(p.smoothing)) return "smoothing: " + *bad;
+  if (auto bad = validate(p.reference)) return "reference: " + *bad;
+  return std::nullopt;
+}
+
+const char* to_string(PlanStatus s) {
+  switch (s) {
+    case PlanStatus::Ok: return "ok";
+    case PlanStatus::BadParams: return "bad parameters";
+    case PlanStatus::BadInput: return "bad input";
+    case PlanStatus::NoTriangulation: return "no triangulation";
+    case PlanStatus::NoCentreline: return "no centreline";
+    case PlanStatus::NoReference: return "no reference";
+  }
+  return "?";
+}
+
+PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, double speed,
+                     const PathPlannerParams& params) {
+  PlanResult out;
+  if (!triangulate_and_search(cone_map, vehicle, speed, params, out)) return out;
+
+  // the raw centreline: a lap as found, an open path from the vehicle on
+  out.closed = out.search.closed;
+  if (!out.closed) {
+    const Vec2 car = vehicle.position();
+    if (distance(car, out.search.points.front()) > kSamePoint) out.centreline.push_back(car);
+  }
+  out.centreline.insert(out.centreline.end(), out.search.points.begin(), out.search.points.end());
+
+  // smoothing, then the spline and the velocity profile: an open path ends
+  // at rest, where the seen track ends
+  out.smoothed = smooth_centreline(out.centreline, out.closed, params.smoothing);
+  const std::optional<double> v_start =
+      out.closed ? std::nullopt : std::optional<double>(std::max(0.0, speed));
+  const std::optional<double> v_end = out.closed ? std::nullopt : std::optional<double>(0.0);
+  ReferenceResult ref = build_reference(out.smoothed, out.closed, params.reference, v_start, v_end);
+  if (!ref.ok()) {
+    out.status = PlanStatus::NoReference;
+    out.reason = "planner: " + ref.reason;
+    return out;
+  }
+  out.trajectory = std::move(ref.trajectory);
+  out.status = PlanStatus::Ok;
+  return out;
+}
+
+LineFit fit_line(const std::vector<Vec2>& points) {
+  LineFit fit;
+  if (points.size() < 2) {
+    fit.reason = "line fit: fewer than 2 points";
+    return fit;
+  }
+  // centroid and covariance
+  Vec2 c{0.0, 0.0};
+  for (const Vec2& p : points) {
+    if (!(std::isfinite(p.x) && std::isfinite(p.y))) {
+      fit.reason = "line fit: a point is not finite";
+      return fit;
+    }
+    c += p;
+  }
+  const double n = static_cast<double>(points.size());
+  c = c / n;
+  double sxx = 0.0, sxy = 0.0, syy = 0.0;
+  for (const Vec2& p : points) {
+    const Vec2 d = p - c;
+    sxx += d.x * d.x;
+    sxy += d.x * d.y;
+    syy += d.y * d.y;
+  }
+  sxx /= n;
+  sxy /= n;
+  syy /= n;
+  if (!(sxx + syy > 0.0)) {
+    fit.reason = "line fit: all points coincide";
+    return fit;
+  }
+  // the principal axis of [[sxx, sxy], [sxy, syy]] is at angle
+  // 0.5 atan2(2 sxy, sxx - syy); the smaller eigenvalue is the mean squared
+  // distance from the line: (sxx + syy)/2 - sqrt(((sxx - syy)/2)^2 + sxy^2)
+  const double angle = 0.5 * std::atan2(2.0 * sxy, sxx - syy);
+  const double half = 0.5 * (sxx - syy);
+  const double lambda_min = 0.5 * (sxx + syy) - std::sqrt(half * half + sxy * sxy);
+  fit.point = c;
+  fit.direction = unit_from_angle(angle);
+  fit.rms = std::sqrt(std::max(0.0, lambda_min));
+  return fit;
+}
+
+PlanResult plan_acceleration(const std::vector<Cone>& cone_map, const Pose2& vehicle,
+                             double speed, const PathPlannerParams& params,
+                             std::optional<double> length) {
+  PlanResult out;
+  if (length && !(std::isfinite(*length) && *length > 0.0)) {
+    out.status = PlanStatus::BadInput;
+    out.reason = "planner: the acceleration length must be a positive length (m)";
+    return out;
+  }
+  if (!triangulate_and_search(cone_map, vehicle, speed, params, out)) return out;
+  out.closed = false;
+  out.centreline = out.search.points;
+
+  // the line through the centreline points, pointing the way the car heads
+  const LineFit line = fit_line(out.search.points);
+  if (!line.ok()) {
+    out.status = PlanStatus::NoCentreline;
+    out.reason = "planner: " + line.reason;
+    return out;
+  }
+  Vec2 dir = line.direction;
+  if (dot(dir, vehicle.heading()) < 0.0) dir = -dir;
+  // from the car's projection onto the line, to the farthest point or `length`
+  const Vec2 start = line.point + dir * dot(vehicle.position() - line.point, dir);
+  double far = 0.0;
+  for (const Vec2& p : out.search.points) far = std::max(far, dot(p - start, dir));
+  const double run = length.value_or(far);
+  if (!(run > params.reference.ds)) {
+    out.status = PlanStatus::NoCentreline;
+    out.reason = "planner: the centreline ends behind the vehicle";
+    return out;
+  }
+  out.smoothed = {start, start + dir * run};
+  ReferenceResult ref =
+      build_reference(out.smoothed, false, params.reference, std::max(0.0, speed), 0.0);
+  if (!ref.ok()) {
+    out.status = PlanStatus::NoReference;
+    out.reason = "planner: " + ref.reason;
+    return out;
+  }
+  out.trajectory = std::move(ref.trajectory);
+  out.status = PlanStatus::Ok;
+  return out;
+}
+
+}  // namespace paddock::planning
