@@ -234,10 +234,12 @@ hal::ConeDetections ConeSensor::measure(const std::vector<Cone>& cones, const st
     hal::DetectedCone det;
     det.position = mount + Vec2{rm * std::cos(bm), rm * std::sin(bm)};
 
-    // colour: unknown first, else a flip to the look-alike
+    // colour: unknown first, else a flip to the look-alike. A big cone stays
+    // big when its colour is lost: a LiDAR measures its height (505 mm against
+    // 325 mm), so the timing lines' cones are known even without colour
     det.color = k.color;
     if (u_unknown < p.unknown_color_probability + p.unknown_color_growth * q) {
-      det.color = ConeColor::Unknown;
+      det.color = k.color == ConeColor::BigOrange ? ConeColor::BigOrange : ConeColor::Unknown;
     } else if (u_flip < p.color_flip_probability + p.color_flip_growth * q) {
       det.color = flipped(k.color);
     }
