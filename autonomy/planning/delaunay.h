@@ -42,7 +42,7 @@ struct Triangulation {
   std::vector<TriFace> triangles;
   // for each input cone, the cone that stands for it in the triangulation:
   // itself, the lowest-index cone it was merged with (cones closer than
-  // merge_distance), or kNoCone when its position is not finite
+  // kConeMergeDistance), or kNoCone when its position is not finite
   std::vector<std::size_t> representative;
   std::size_t vertices = 0;  // distinct cones triangulated
   std::size_t merged = 0;    // cones merged into another one

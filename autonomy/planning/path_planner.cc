@@ -79,14 +79,31 @@ PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, do
     if (distance(car, out.search.points.front()) > kSamePoint) out.centreline.push_back(car);
   }
   out.centreline.insert(out.centreline.end(), out.search.points.begin(), out.search.points.end());
+  // a lap closes where it began: points at its end that overlap its first
+  // step (past the first point, or on it) would fold the closed spline into
+  // a cusp at the join
+  if (out.closed) {
+    std::vector<Vec2>& c = out.centreline;
+    while (c.size() > 4 &&
+           (distance(c.back(), c.front()) < 1.0 || dot(c.back() - c.front(), c[1] - c[0]) > 0.0)) {
+      c.pop_back();
+    }
+  }
 
   // smoothing, then the spline and the velocity profile: an open path ends
   // at rest, where the seen track ends
   out.smoothed = smooth_centreline(out.centreline, out.closed, params.smoothing);
+  enforce_clearance(out.smoothed, cone_map, params.clearance);
   const std::optional<double> v_start =
       out.closed ? std::nullopt : std::optional<double>(std::max(0.0, speed));
   const std::optional<double> v_end = out.closed ? std::nullopt : std::optional<double>(0.0);
   ReferenceResult ref = build_reference(out.smoothed, out.closed, params.reference, v_start, v_end);
+  // the spline can swing back towards a cone between the points: push the
+  // points near such samples further and fit again (a few rounds)
+  for (int round = 0; round < 3 && ref.ok(); ++round) {
+    if (clear_trajectory(out.smoothed, ref.trajectory, cone_map, params.clearance) == 0) break;
+    ref = build_reference(out.smoothed, out.closed, params.reference, v_start, v_end);
+  }
   if (!ref.ok()) {
     out.status = PlanStatus::NoReference;
     out.reason = "planner: " + ref.reason;

@@ -1,7 +1,8 @@
 #pragma once
 // one planning cycle (paper section "Planning"): the Delaunay triangulation
-// of the cone map, the centreline search from the vehicle, smoothing, and
-// the reference trajectory (C2 spline and velocity profile). Autocross and
+// of the cone map, the centreline search from the vehicle, smoothing, a
+// clearance pass that keeps the points away from the cones (clearance.h),
+// and the reference trajectory (C2 spline and velocity profile). Autocross and
 // trackdrive use plan_path; acceleration fits a line to the centreline
 // (plan_acceleration).
 #include <optional>
@@ -12,6 +13,7 @@
 #include "autonomy/common/geometry.h"
 #include "autonomy/common/trajectory.h"
 #include "autonomy/planning/centreline.h"
+#include "autonomy/planning/clearance.h"
 #include "autonomy/planning/delaunay.h"
 #include "autonomy/planning/reference.h"
 #include "autonomy/planning/smoothing.h"
@@ -21,6 +23,7 @@ namespace paddock::planning {
 struct PathPlannerParams {
   CentrelineParams search;
   SmoothingParams smoothing;
+  ClearanceParams clearance;  // the smoothed points are pushed clear of the cones
   ReferenceParams reference;
 };
 
@@ -38,8 +41,9 @@ enum class PlanStatus {
 
 struct PlanResult {
   Trajectory trajectory;          // empty unless Ok
-  std::vector<Vec2> centreline;   // raw: open, the vehicle's position and then the search's points
-  std::vector<Vec2> smoothed;     // what the spline is fitted through
+  std::vector<Vec2> centreline;   // raw: open, the vehicle's position and then the search's points;
+                                  // closed, the search's lap (end points overlapping its start dropped)
+  std::vector<Vec2> smoothed;     // smoothed and pushed clear of the cones: what the spline is fitted through
   bool closed = false;            // a full lap: closed spline and closed velocity profile
   Triangulation triangulation;    // for plots: the grey layer, the midpoints
   CentrelineResult search;        // the search's points, scores and stop reason

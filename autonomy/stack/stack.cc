@@ -133,14 +133,21 @@ void Stack::plan(const hal::StateEstimate& st) {
   } else if (res.closed) {
     // a closed centreline is the whole lap once the car has driven most of it;
     // before that it is the search cutting across a map still being explored
-    if (driven_ >= mp.loop_closure_distance) {
-      trajectory_ = res.trajectory;
+    const bool back_at_start =
+        start_position_ && distance(st.pose.position(), *start_position_) < mp.loop_closure_radius;
+    if (driven_ >= mp.loop_closure_distance && (back_at_start || mp.loop_closure_radius <= 0.0)) {
+      pending_lap_ = res.trajectory;
       telemetry_.lap_locked = spec_.mission == Mission::Trackdrive;
+    } else if (driven_ >= mp.loop_closure_distance) {
+      // the search closes the loop from the car before the car is back at its
+      // start: the path is good ahead, so drive it, and keep planning
+      trajectory_ = res.trajectory;
     }
   } else {
     trajectory_ = res.trajectory;
   }
   last_plan_ = std::move(res);
+  last_plan_cones_ = cones;
   if (spec_.gates.empty()) learn_gates(st.pose);
 }
 
@@ -206,6 +213,16 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   }
   const hal::StateEstimate& st = *state_;
   const double speed = std::hypot(st.vx, st.vy);
+  if (!start_position_) start_position_ = st.pose.position();
+
+  // the closed lap takes over where the car is on it
+  if (!pending_lap_.empty()) {
+    const Vec2 front = st.pose.transform({params_.vehicle.wheelbase, 0.0});
+    if (std::abs(project(pending_lap_, front, 0.0, 0.0).offset) < params_.mission.lap_switch_offset) {
+      trajectory_ = std::move(pending_lap_);
+      pending_lap_ = Trajectory{};
+    }
+  }
   driven_ += speed * dt;
 
   // mission progress: gate crossings of the base origin

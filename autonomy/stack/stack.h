@@ -39,10 +39,15 @@ struct MissionParams {
   // the least start speed of a planned profile (m/s): a car at rest needs a
   // reference above zero to start on
   double launch_speed = 2.0;
-  // trackdrive: a closed centreline found after at least this much driving is
-  // the lap, planned once and driven from then on (m); earlier closures are
-  // the search cutting across a map that is still being explored
+  // trackdrive: a closed centreline is the lap, planned once and driven from
+  // then on, when the car has driven at least this far (m) and is back within
+  // this distance of where it started (m): then every cone of the lap has been
+  // seen; earlier closures are the search cutting across a map still being explored
   double loop_closure_distance = 100.0;
+  double loop_closure_radius = 15.0;
+  // the closed lap takes over from the exploration path only where the car
+  // is this close to it (m), so the handover does not jerk the car sideways
+  double lap_switch_offset = 0.1;
   // a timekeeping gate is learned from big orange cones seen at least this
   // often (-) whose gate's middle lies this close to the planned path (m):
   // a ghost cone of perception must not become a finish line
@@ -115,6 +120,8 @@ class Stack {
   const slam::ConeMap& cone_map() const { return cone_map_; }
   // the last planning cycle's result (planner = delaunay), for plots
   const planning::PlanResult& last_plan() const { return last_plan_; }
+  // the map the last plan was made on (its triangulation indexes these)
+  const std::vector<Cone>& last_plan_cones() const { return last_plan_cones_; }
   const std::vector<Segment>& gates() const { return gates_; }
 
  private:
@@ -140,9 +147,12 @@ class Stack {
   slam::ConeMap cone_map_;
   bool map_news_ = false;                   // detections since the last plan
   planning::PlanResult last_plan_;
+  std::vector<Cone> last_plan_cones_;
+  Trajectory pending_lap_;                  // the closed lap, waiting for a smooth handover
   std::vector<Segment> gates_;              // known and learned timekeeping gates
   std::optional<Vec2> last_base_position_;  // for the gate crossing test
   double driven_ = 0.0;                     // distance driven (m)
+  std::optional<Vec2> start_position_;      // where the car began to drive
   double last_crossing_at_ = -1e9;          // driven_ at the last counted crossing (m)
   bool go_ = false;
   bool emergency_ = false;

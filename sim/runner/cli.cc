@@ -102,6 +102,7 @@ int cmd_run(const std::vector<std::string>& args) {
   const std::string js = summary_json(sc, result, failed);
   write_file_atomic(out_dir + "/scenario.ini", resolved_ini(sc));
   write_file_atomic(out_dir + "/log.csv", log_csv(result.log));
+  write_file_atomic(out_dir + "/plan.json", plan_json(result));
   write_file_atomic(out_dir + "/summary.json", js);
 
   std::vector<std::string> figures;

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "render/figures.h"
@@ -48,6 +49,52 @@ SummaryLaps read_summary(const std::string& path) {
     throw UserError(path + ": not a paddock summary: " + e.what());
   }
   return s;
+}
+
+// the layers of DIR/plan.json, when the run planned from cones
+void add_plan_layers(const std::string& path, render::TrackMapData& map) {
+  if (!std::filesystem::exists(path)) return;
+  const std::string text = read_file(path);
+  try {
+    const nlohmann::json j = nlohmann::json::parse(text);
+    auto points = [](const nlohmann::json& a) {
+      std::vector<Vec2> out;
+      for (const auto& p : a) out.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
+      return out;
+    };
+    render::MapLayer tri;
+    tri.kind = render::MapLayer::Kind::Segments;
+    tri.label = "Delaunay triangulation";
+    tri.color = {170, 170, 170, 255};
+    tri.size = 0.5;
+    for (const auto& e : j.at("triangulation")) {
+      tri.points.push_back({e.at(0).get<double>(), e.at(1).get<double>()});
+      tri.points.push_back({e.at(2).get<double>(), e.at(3).get<double>()});
+    }
+    render::MapLayer mid;
+    mid.kind = render::MapLayer::Kind::Points;
+    mid.label = "edge midpoints";
+    mid.color = {230, 120, 200, 255};
+    mid.size = 2.0;
+    mid.points = points(j.at("midpoints"));
+    render::MapLayer centre;
+    centre.kind = render::MapLayer::Kind::Points;
+    centre.label = "centreline points";
+    centre.color = {0, 160, 60, 255};
+    centre.size = 3.5;
+    centre.points = points(j.at("centreline"));
+    for (auto* layer : {&tri, &mid, &centre})
+      if (!layer->points.empty()) map.layers.push_back(*layer);
+    for (const auto& c : j.at("mapped_cones")) {
+      ConeColor color = ConeColor::Unknown;
+      const std::string tag = c.at(2).get<std::string>();
+      for (ConeColor k : {ConeColor::Blue, ConeColor::Yellow, ConeColor::SmallOrange, ConeColor::BigOrange})
+        if (tag == cone_tag(k)) color = k;
+      map.estimated_cones.push_back({{c.at(0).get<double>(), c.at(1).get<double>()}, color});
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw UserError(path + ": not a paddock plan: " + e.what());
+  }
 }
 
 void write_png(const std::string& path, const render::Image& image) {
@@ -140,6 +187,8 @@ std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) 
     map.trajectory.push_back({r.x, r.y});
     map.speed.push_back(std::hypot(r.vx, r.vy));
   }
+
+  add_plan_layers(dir + "/plan.json", map);
 
   // the controller data over the whole run, laps marked
   render::ControllerData ctl;

@@ -136,6 +136,25 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
   return j.dump() + "\n";
 }
 
+std::string plan_json(const RunResult& r) {
+  using Json = nlohmann::ordered_json;
+  auto points = [](const std::vector<Vec2>& pts) {
+    Json a = Json::array();
+    for (const Vec2& p : pts) a.push_back({p.x, p.y});
+    return a;
+  };
+  Json edges = Json::array();
+  for (const Segment& s : r.plan.triangulation) edges.push_back({s.a.x, s.a.y, s.b.x, s.b.y});
+  Json cones = Json::array();
+  for (const Cone& c : r.plan.mapped_cones) cones.push_back({c.position.x, c.position.y, std::string(cone_tag(c.color))});
+  const Json j = {{"triangulation", edges},
+                  {"midpoints", points(r.plan.midpoints)},
+                  {"centreline", points(r.plan.centreline)},
+                  {"mapped_cones", cones},
+                  {"reference", points(r.plan.reference)}};
+  return j.dump() + "\n";
+}
+
 std::string log_csv(const std::vector<LogRow>& log) {
   std::string out =
       "t,x,y,yaw,vx,vy,yaw_rate,steer_cmd,steer,throttle,brake,v_ref,lateral_error,heading_error,s,lap,as_state\n";

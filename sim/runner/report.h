@@ -18,6 +18,9 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
 // one JSON object (schema in the README)
 std::string summary_json(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed);
 
+// the stack's last plan and map (plan.json): the map's optional layers
+std::string plan_json(const RunResult& r);
+
 // the log rows as CSV with a header line
 std::string log_csv(const std::vector<LogRow>& log);
 

@@ -261,12 +261,24 @@ std::vector<Field> build_fields() {
   f.push_back(real_field("planning", "turn_accel_scale", "", 0.0, 1.0, "longitudinal limits kept in a full-grip turn",
                          ACC(planning.reference.profile.turn_accel_scale)));
 
+  // [slam]
+  f.push_back(real_field("slam", "association_distance", "m", 0.01, 10.0, "a detection farther from every mapped cone starts a new one",
+                         ACC(cone_map.association_distance)));
+  f.push_back(int_field("slam", "min_observations", "", 1, 1000, "sightings before a mapped cone counts", ACC(cone_map.min_observations)));
+
   // [mission]
   f.push_back(real_field("mission", "stop_decel", "m/s^2", 0.1, 50.0, "deceleration of the stop after the finish", ACC(mission.stop_decel)));
   f.push_back(real_field("mission", "standstill_speed", "m/s", 0.0, 5.0, "below this the stack counts as stopped",
                          ACC(mission.standstill_speed)));
   f.push_back(real_field("mission", "state_timeout", "s", 0.001, 10.0, "a staler state estimate triggers the safe stop",
                          ACC(mission.state_timeout)));
+
+  f.push_back(real_field("mission", "loop_closure_distance", "m", 0.0, 10000.0, "driving before a closed centreline is the lap",
+                         ACC(mission.loop_closure_distance)));
+  f.push_back(real_field("mission", "loop_closure_radius", "m", 0.0, 10000.0,
+                         "the car must be this close to its start for the lap to be taken (0: anywhere)", ACC(mission.loop_closure_radius)));
+  f.push_back(real_field("mission", "lap_switch_offset", "m", 0.0, 10.0, "the closed lap takes over where the car is this close to it",
+                         ACC(mission.lap_switch_offset)));
 
   // [event]
   f.push_back(real_field("event", "timeout", "s", 1.0, 86400.0, "sim time after the go before a DNF", ACC(event.timeout)));
@@ -451,6 +463,7 @@ stack::StackParams stack_params(const Scenario& s) {
   p.modes = s.autonomy;
   p.control = s.control;
   p.mission = s.mission;
+  p.cone_map = s.cone_map;
   // what the stack knows of its car comes from the same [vehicle] section as
   // the simulated car: one place for each value
   const vehicle::VehicleParams& v = s.vehicle;

@@ -60,6 +60,7 @@ struct Scenario {
   planning::PathPlannerParams planning;
   planning::SkidpadParams skidpad;
   stack::MissionParams mission;
+  slam::ConeMapParams cone_map;  // [slam]: the cone map of slam = ground_truth
   world::ConeWorldParams cones;
   events::EventParams event;
   SimSection sim;

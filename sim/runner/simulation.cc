@@ -234,6 +234,18 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   res.sim_time = res.log.empty() ? 0.0 : res.log.back().t;
   res.fallbacks = stack.telemetry().fallbacks;
   res.fault = stack.telemetry().last_fault;
+  // the stack's last plan and map, for the figures
+  const planning::PlanResult& plan = stack.last_plan();
+  const std::vector<Cone>& plan_cones = stack.last_plan_cones();
+  for (const planning::TriEdge& e : plan.triangulation.edges) {
+    if (e.a < plan_cones.size() && e.b < plan_cones.size()) {
+      res.plan.triangulation.push_back({plan_cones[e.a].position, plan_cones[e.b].position});
+      res.plan.midpoints.push_back(e.midpoint);
+    }
+  }
+  res.plan.centreline = plan.search.points;
+  res.plan.mapped_cones = stack.cone_map().cones();
+  for (const TrajectoryPoint& p : stack.trajectory().points) res.plan.reference.push_back(p.position());
   for (const world::DooEvent& d : cones.doo_events()) {
     const Cone& c = cones.cone(d.cone);
     res.cones_hit.push_back({c.position, c.color, to_seconds(d.time_ns), d.cause == world::DooCause::Knocked});

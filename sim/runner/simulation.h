@@ -53,8 +53,18 @@ struct ConeHit {
   bool knocked = false;  // knocked over by an impact (else: displaced out of its place)
 };
 
+// what the stack planned last, for the map's layers (planner = delaunay)
+struct PlanSnapshot {
+  std::vector<Segment> triangulation;  // the Delaunay edges of the map it planned on
+  std::vector<Vec2> midpoints;         // the candidate points: the edges' midpoints
+  std::vector<Vec2> centreline;        // the points the search chose
+  std::vector<Cone> mapped_cones;      // the stack's cone map at the end of the run
+  std::vector<Vec2> reference;         // the trajectory it drove last
+};
+
 struct RunResult {
   events::Result event;
+  PlanSnapshot plan;
   std::vector<ConeHit> cones_hit;
   std::vector<LapTracking> lap_tracking;  // one per completed lap
   Tracking tracking;

@@ -213,6 +213,21 @@ bool winds_right(const std::vector<Vec2>& path, const Boundaries& b) {
   return true;
 }
 
+// the margins the tests hold: the smallest distance (m) from any point of
+// the raw centreline, the smoothed one and the trajectory to the true
+// boundary lines (cone-to-cone segments). Measured with the default
+// parameters (minimum over the tracks, raw / smoothed / trajectory):
+//   ground truth, full lap:       1.36 / 1.10 / 1.08 (fss_2019 raw; fsg_2023)
+//   the same with no colour:      1.36 / 1.10 / 1.08
+//   cones within 20 m, open path: 1.26 / - / 1.25 (fsg_2024)
+//   10 % missed, 5 % swapped, 0.1 m noise, laps that close (20 seeds):
+//     fsg_2019 0.14 / - / 0.24 (where a missed inner cone lets the line cut
+//     a corner that the true boundary still has), fsg_2023 0.79 / - / 0.57
+constexpr double kLapMargin = 1.0;
+constexpr double kPartialMargin = 1.0;
+constexpr double kErrorMargin = 0.1;
+constexpr unsigned kRobustSeeds = 20;
+
 const std::vector<std::string> kCircuits{
     "fsg_2019",      "fsg_2021",      "fsg_2023",         "fsg_2024",        "fse_2022",
     "fse_2022_test", "fse_2023",      "fse_2024",         "fss_2019",        "fss_2022_v1",
@@ -273,6 +288,284 @@ TEST(PathPlannerTracks, FullLapOnEveryCircuitStaysInside) {
     EXPECT_TRUE(r.closed) << name << ": " << r.reason;
     EXPECT_TRUE(r.inside) << name;
     EXPECT_TRUE(r.winds) << name;
+    EXPECT_GT(r.raw, kLapMargin) << name;
+    EXPECT_GT(r.smoothed, kLapMargin) << name;
+    EXPECT_GT(r.trajectory, kLapMargin) << name;
+  }
+}
+
+
+// ---- perception errors and LiDAR-only maps ------------------------------------------
+
+// the map a good perception pipeline might build: each cone missed with
+// probability `miss`, blue and yellow swapped with probability `flip`,
+// Gaussian position noise of `noise` m on each axis; seeded
+std::vector<Cone> perturb(const std::vector<Cone>& in, unsigned seed, double miss, double flip,
+                          double noise) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::vector<Cone> out;
+  for (Cone c : in) {
+    const bool missed = u(rng) < miss;
+    const bool flipped = u(rng) < flip;
+    const double dx = noise * n(rng), dy = noise * n(rng);
+    if (missed) continue;
+    if (flipped && c.color == ConeColor::Blue) c.color = ConeColor::Yellow;
+    else if (flipped && c.color == ConeColor::Yellow) c.color = ConeColor::Blue;
+    c.position += Vec2{dx, dy};
+    out.push_back(c);
+  }
+  return out;
+}
+
+std::vector<Cone> without_colour(std::vector<Cone> cones) {
+  for (Cone& c : cones) c.color = ConeColor::Unknown;
+  return cones;
+}
+
+TEST(PathPlannerTracks, LidarOnlyFullLapOnEveryCircuit) {
+  for (const auto& name : kCircuits) {
+    const TrackFile t = read_track(name);
+    const Boundaries b = boundaries(t);
+    ASSERT_TRUE(b.ok) << name;
+    const LapReport r = plan_lap(without_colour(t.cones), start_pose(t), b);
+    std::printf("no colour %-18s closed %d raw %.2f smoothed %.2f traj %.2f\n", name.c_str(),
+                r.closed, r.raw, r.smoothed, r.trajectory);
+    EXPECT_TRUE(r.closed) << name << ": " << r.reason;
+    EXPECT_TRUE(r.inside) << name;
+    EXPECT_TRUE(r.winds) << name;
+    EXPECT_GT(r.raw, kLapMargin) << name;
+    EXPECT_GT(r.smoothed, kLapMargin) << name;
+    EXPECT_GT(r.trajectory, kLapMargin) << name;
+  }
+}
+
+// 20 seeded maps of each track with 10 % of the cones missed, 5 % of the
+// blue and yellow ones swapped and 0.1 m of noise, with their colours and
+// without. Measured: with colours 17 (FSG 2019) and 18 (FSG 2023) of 20
+// close the lap inside the true boundaries, and the others stop safely
+// inside at a gap of missed cones they cannot bridge (two or three in a
+// row on one side); without colours 13 and 18 close, 5 stop inside, and 2
+// of the 40 leave the track (FSG 2019 seeds 9 and 18) where missed cones
+// opened a gap into a neighbouring part of the track. The bounds leave one
+// lap of slack.
+TEST(PathPlannerTracks, PerceptionErrorsOnFsg2019AndFsg2023) {
+  for (const std::string name : {"fsg_2019", "fsg_2023"}) {
+    const TrackFile t = read_track(name);
+    const Boundaries b = boundaries(t);
+    ASSERT_TRUE(b.ok);
+    unsigned laps = 0, laps_no_colour = 0;
+    for (unsigned seed = 1; seed <= kRobustSeeds; ++seed) {
+      const auto cones = perturb(t.cones, seed, 0.10, 0.05, 0.1);
+      for (bool colour : {true, false}) {
+        const LapReport r = plan_lap(colour ? cones : without_colour(cones), start_pose(t), b);
+        std::printf("errors%s %-9s seed %2u: closed %d inside %d raw %.2f traj %.2f %s\n",
+                    colour ? "          " : " no colour", name.c_str(), seed, r.closed, r.inside,
+                    r.raw, r.trajectory, r.reason.c_str());
+        const bool lap = r.closed && r.inside && r.winds;
+        (colour ? laps : laps_no_colour) += lap ? 1 : 0;
+        if (lap) {
+          EXPECT_GT(r.raw, kErrorMargin) << name << " seed " << seed << " colour " << colour;
+          EXPECT_GT(r.trajectory, kErrorMargin) << name << " seed " << seed << " colour " << colour;
+        }
+        // with colours, a lap that does not close still stays on the track
+        if (colour) {
+          EXPECT_TRUE(r.inside) << name << " seed " << seed;
+        }
+      }
+    }
+    std::printf("%s: %u of %u laps close inside with colours, %u without\n", name.c_str(), laps,
+                kRobustSeeds, laps_no_colour);
+    EXPECT_GE(laps, name == "fsg_2019" ? 16u : 17u) << name;
+    EXPECT_GE(laps_no_colour, name == "fsg_2019" ? 12u : 17u) << name;
+  }
+}
+
+// ---- partial maps: what the car sees at the start -----------------------------------
+
+TEST(PathPlannerTracks, PartialMapGivesAnOpenPathThatEndsAtRest) {
+  const double seen = 20.0;  // m around the start pose
+  for (const auto& name : kCircuits) {
+    const TrackFile t = read_track(name);
+    const Boundaries b = boundaries(t);
+    const Pose2 start = start_pose(t);
+    std::vector<Cone> near;
+    for (const Cone& c : t.cones)
+      if (distance(c.position, start.position()) <= seen) near.push_back(c);
+    const double speed = 3.0;  // m/s
+    const PlanResult plan = plan_path(near, start, speed);
+    ASSERT_TRUE(plan.ok()) << name << ": " << plan.reason;
+    EXPECT_FALSE(plan.closed) << name;
+    const Trajectory& traj = plan.trajectory;
+    ASSERT_FALSE(traj.empty());
+    EXPECT_FALSE(traj.closed);
+    // from the car, ahead of it, inside the track
+    EXPECT_NEAR(traj.points.front().x, start.x, 1e-9) << name;
+    EXPECT_NEAR(traj.points.front().y, start.y, 1e-9) << name;
+    EXPECT_GT(dot(traj.points.back().position() - start.position(), start.heading()), 8.0) << name;
+    const Fit raw = fit_in(b, plan.centreline), tr = fit_in(b, trajectory_points(traj));
+    std::printf("partial %-18s points %2zu length %5.1f raw %.2f traj %.2f\n", name.c_str(),
+                plan.centreline.size(), traj.length, raw.min_clearance, tr.min_clearance);
+    EXPECT_TRUE(raw.inside && tr.inside) << name;
+    EXPECT_GT(raw.min_clearance, kPartialMargin) << name;
+    EXPECT_GT(tr.min_clearance, kPartialMargin) << name;
+    // within the seen area, ending at rest; no faster than the car at first
+    for (const auto& p : traj.points) EXPECT_LE(distance(p.position(), start.position()), seen + 1e-9) << name;
+    EXPECT_EQ(traj.points.back().speed, 0.0) << name;
+    EXPECT_LE(traj.points.front().speed, speed + 1e-9) << name;
+  }
+}
+
+// ---- abnormal maps: no trajectory and a reason ----------------------------------------
+
+TEST(PathPlanner, AbnormalInputsGiveNoTrajectoryAndAReason) {
+  const Pose2 start{0.0, 0.0, 0.0};
+  auto expect_no_plan = [&](const std::vector<Cone>& cones, PlanStatus want, const char* what) {
+    const PlanResult r = plan_path(cones, start, 0.0);
+    EXPECT_EQ(r.status, want) << what << ": " << r.reason;
+    EXPECT_FALSE(r.ok()) << what;
+    EXPECT_FALSE(r.reason.empty()) << what;
+    EXPECT_TRUE(r.trajectory.points.empty()) << what;
+    std::printf("%-22s -> %s: %s\n", what, to_string(r.status), r.reason.c_str());
+  };
+  expect_no_plan({}, PlanStatus::NoTriangulation, "empty map");
+  expect_no_plan({{{3.0, 1.5}, ConeColor::Blue}}, PlanStatus::NoTriangulation, "one cone");
+  std::vector<Cone> line;
+  for (int i = 0; i < 8; ++i) line.push_back({{3.0 * i, 1.5}, ConeColor::Blue});
+  expect_no_plan(line, PlanStatus::NoTriangulation, "collinear cones");
+  std::vector<Cone> doubled_one(4, Cone{{3.0, 1.5}, ConeColor::Yellow});
+  expect_no_plan(doubled_one, PlanStatus::NoTriangulation, "one cone four times");
+  const TrackFile t = read_track("fsg_2019");
+  for (ConeColor c : {ConeColor::Blue, ConeColor::Yellow}) {
+    std::vector<Cone> one;
+    for (const Cone& k : t.cones)
+      if (k.color == c) one.push_back(k);
+    expect_no_plan(one, PlanStatus::NoCentreline, c == ConeColor::Blue ? "only blue cones" : "only yellow cones");
+  }
+  std::vector<Cone> all_blue = t.cones;
+  for (Cone& k : all_blue) k.color = ConeColor::Blue;
+  expect_no_plan(all_blue, PlanStatus::NoCentreline, "all cones blue");
+  std::vector<Cone> nan(6, Cone{{std::nan(""), 0.0}, ConeColor::Blue});
+  expect_no_plan(nan, PlanStatus::NoTriangulation, "NaN cones");
+
+  // a bad pose or speed, bad parameters
+  EXPECT_EQ(plan_path(t.cones, {std::nan(""), 0.0, 0.0}, 0.0).status, PlanStatus::BadInput);
+  EXPECT_EQ(plan_path(t.cones, start, std::nan("")).status, PlanStatus::BadInput);
+  PathPlannerParams bad;
+  bad.smoothing.window = 2;
+  const PlanResult r = plan_path(t.cones, start, 0.0, bad);
+  EXPECT_EQ(r.status, PlanStatus::BadParams);
+  EXPECT_FALSE(r.reason.empty());
+  bad = {};
+  bad.reference.ds = -1.0;
+  EXPECT_EQ(plan_path(t.cones, start, 0.0, bad).status, PlanStatus::BadParams);
+}
+
+TEST(PathPlanner, DoubledMapPlansTheSameLap) {
+  const TrackFile t = read_track("fsg_2021");
+  std::vector<Cone> doubled = t.cones;
+  for (const Cone& c : t.cones) doubled.push_back({c.position + Vec2{0.003, 0.002}, c.color});
+  const PlanResult a = plan_path(t.cones, start_pose(t), 0.0);
+  const PlanResult b = plan_path(doubled, start_pose(t), 0.0);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_TRUE(b.closed);
+  EXPECT_EQ(b.triangulation.merged, t.cones.size());
+  ASSERT_EQ(a.centreline.size(), b.centreline.size());
+  for (std::size_t i = 0; i < a.centreline.size(); ++i) EXPECT_EQ(a.centreline[i], b.centreline[i]);
+  EXPECT_NEAR(a.trajectory.length, b.trajectory.length, 1e-9);
+}
+
+TEST(PathPlanner, Deterministic) {
+  const TrackFile t = read_track("fsg_2023");
+  const PlanResult a = plan_path(t.cones, start_pose(t), 2.0);
+  const PlanResult b = plan_path(t.cones, start_pose(t), 2.0);
+  ASSERT_TRUE(a.ok());
+  ASSERT_EQ(a.trajectory.points.size(), b.trajectory.points.size());
+  for (std::size_t i = 0; i < a.trajectory.points.size(); ++i) {
+    EXPECT_EQ(a.trajectory.points[i].x, b.trajectory.points[i].x);
+    EXPECT_EQ(a.trajectory.points[i].y, b.trajectory.points[i].y);
+    EXPECT_EQ(a.trajectory.points[i].speed, b.trajectory.points[i].speed);
+  }
+}
+
+TEST(PathPlanner, ClosedLapHasAClosedProfile) {
+  const TrackFile t = read_track("fsg_2023");
+  const PlanResult plan = plan_path(t.cones, start_pose(t), 0.0);
+  ASSERT_TRUE(plan.ok()) << plan.reason;
+  ASSERT_TRUE(plan.closed);
+  EXPECT_TRUE(plan.trajectory.closed);
+  // the profile is periodic: nobody stops on a closed lap, and the speed at
+  // the end of the lap leads into its start
+  double v_min = kInf;
+  for (const auto& p : plan.trajectory.points) v_min = std::min(v_min, p.speed);
+  EXPECT_GT(v_min, 3.0);
+  const double ds = plan.trajectory.length / static_cast<double>(plan.trajectory.points.size());
+  const double dv2 = std::abs(plan.trajectory.points.back().speed * plan.trajectory.points.back().speed -
+                              plan.trajectory.points.front().speed * plan.trajectory.points.front().speed);
+  EXPECT_LE(dv2, 2.0 * 16.0 * ds);
+  // the raw centreline is the search's lap, the smoothed one is shorter
+  EXPECT_EQ(plan.centreline.size(), plan.search.points.size());
+  EXPECT_LE(plan.smoothed.size(), plan.centreline.size());
+  EXPECT_GT(plan.triangulation.edges.size(), 2 * t.cones.size());
+}
+
+// ---- acceleration: the line fit ----------------------------------------------------------
+
+TEST(PathPlanner, FitLineIsTotalLeastSquares) {
+  // exact points on a slanted line
+  std::vector<Vec2> pts;
+  for (int i = 0; i < 10; ++i) pts.push_back({1.0 + 2.0 * i, -3.0 + 1.0 * i});
+  LineFit f = fit_line(pts);
+  ASSERT_TRUE(f.ok());
+  EXPECT_NEAR(std::abs(cross(f.direction, Vec2{2.0, 1.0} / std::sqrt(5.0))), 0.0, 1e-12);
+  EXPECT_NEAR(f.rms, 0.0, 1e-9);
+  EXPECT_NEAR(f.point.x, 10.0, 1e-12);
+  EXPECT_NEAR(f.point.y, 1.5, 1e-12);
+  // points alternately 0.2 m either side of the x axis: rms 0.2, along x
+  pts.clear();
+  for (int i = 0; i < 20; ++i) pts.push_back({1.0 * i, i % 2 ? 0.2 : -0.2});
+  f = fit_line(pts);
+  ASSERT_TRUE(f.ok());
+  EXPECT_NEAR(std::abs(f.direction.x), 1.0, 1e-3);
+  EXPECT_NEAR(f.rms, 0.2, 1e-3);
+  // a vertical line (ordinary least squares y(x) would fail here)
+  pts = {{2.0, 0.0}, {2.0, 1.0}, {2.0, 5.0}};
+  f = fit_line(pts);
+  ASSERT_TRUE(f.ok());
+  EXPECT_NEAR(std::abs(f.direction.y), 1.0, 1e-12);
+  // degenerate input
+  EXPECT_FALSE(fit_line({}).ok());
+  EXPECT_FALSE(fit_line({{1.0, 1.0}}).ok());
+  EXPECT_FALSE(fit_line({{1.0, 1.0}, {1.0, 1.0}, {1.0, 1.0}}).ok());
+  EXPECT_FALSE(fit_line({{1.0, 1.0}, {std::nan(""), 1.0}}).ok());
+}
+
+TEST(PathPlanner, AccelerationIsAStraightLineDownTheLane) {
+  for (const std::string name : {"acceleration", "acceleration_amz_fssim"}) {
+    const TrackFile t = read_track(name);
+    const Pose2 start = start_pose(t);
+    const PlanResult plan = plan_acceleration(t.cones, start, 0.0);
+    ASSERT_TRUE(plan.ok()) << name << ": " << plan.reason;
+    const Trajectory& traj = plan.trajectory;
+    EXPECT_FALSE(traj.closed);
+    // the lane is the x axis, to the last cone (150 m, FSSIM's 170 m)
+    double x_end = 0.0;
+    for (const Cone& c : t.cones) x_end = std::max(x_end, c.position.x);
+    for (const auto& p : traj.points) {
+      EXPECT_NEAR(p.y, 0.0, 0.05) << name << " s " << p.s;
+      EXPECT_NEAR(p.heading, 0.0, 1e-3) << name;
+      EXPECT_NEAR(p.curvature, 0.0, 1e-6) << name;
+    }
+    EXPECT_NEAR(traj.points.front().x, start.x, 0.05) << name;
+    EXPECT_GT(traj.points.back().x, x_end - 10.0) << name;
+    EXPECT_LE(traj.points.back().x, x_end) << name;
+    EXPECT_EQ(traj.points.back().speed, 0.0);
+    EXPECT_EQ(traj.points.front().speed, 0.0);
+    // a given length: to the end of the braking zone
+    const PlanResult fixed = plan_acceleration(t.cones, start, 0.0, {}, 120.0);
+    ASSERT_TRUE(fixed.ok());
+    EXPECT_NEAR(fixed.trajectory.length, 120.0, 1e-6);
   }
 }
 

@@ -45,13 +45,14 @@ TEST(ConeMap, ColourIsTheMajorityOfTheColouredVotes) {
   ASSERT_EQ(map.cones().size(), 1u);
   EXPECT_EQ(map.cones()[0].color, ConeColor::Yellow);
   ConeMap lidar_only;
-  lidar_only.add({{{0.0, 0.0}, ConeColor::Unknown}});
-  lidar_only.add({{{0.0, 0.0}, ConeColor::Unknown}});
+  for (int f = 0; f < 5; ++f) lidar_only.add({{{0.0, 0.0}, ConeColor::Unknown}});
   EXPECT_EQ(lidar_only.cones()[0].color, ConeColor::Unknown);
 }
 
 TEST(ConeMap, OneFrameGhostsStayOutAndNeighboursStayApart) {
-  ConeMap map;
+  ConeMapParams p;
+  p.min_observations = 2;
+  ConeMap map(p);
   map.add({{{0.0, 0.0}, ConeColor::Blue}, {{7.0, 3.0}, ConeColor::Unknown}});  // the second is a ghost
   map.add({{{0.02, 0.0}, ConeColor::Blue}});
   const auto cones = map.cones();
