@@ -266,6 +266,59 @@ std::vector<Field> build_fields() {
                          ACC(cone_map.association_distance)));
   f.push_back(int_field("slam", "min_observations", "", 1, 1000, "sightings before a mapped cone counts", ACC(cone_map.min_observations)));
 
+  // [planning]: the centreline search (the paper's reward factors and their weights)
+  {
+    struct Key {
+      const char* key;
+      const char* unit;
+      double lo, hi;
+      double planning::CentrelineParams::*member;
+      const char* doc;
+    };
+    using C = planning::CentrelineParams;
+    static const Key keys[] = {
+        {"search_radius", "m", 0.5, 100.0, &C::search_radius, "candidate midpoints within this of the last point"},
+        {"min_step", "m", 0.0, 10.0, &C::min_step, "shortest step"},
+        {"max_turn", "rad", 0.0, 3.2, &C::max_turn, "largest heading change of a step"},
+        {"min_clearance", "m", 0.0, 5.0, &C::min_clearance, "a step passes at least this far from every cone"},
+        {"weight_colour", "", 0.0, 100.0, &C::weight_colour, "reward weight: blue left, yellow right"},
+        {"weight_width", "", 0.0, 100.0, &C::weight_width, "reward weight: track width (3-5 m, Gaussian edges)"},
+        {"weight_angle", "", 0.0, 100.0, &C::weight_angle, "reward weight: small change of angle"},
+        {"weight_step", "", 0.0, 100.0, &C::weight_step, "reward weight: distance between midpoints"},
+        {"weight_prediction", "", 0.0, 100.0, &C::weight_prediction, "reward weight: near the predicted position"},
+        {"weight_crossing", "", 0.0, 100.0, &C::weight_crossing, "reward weight: the step crosses its edge squarely"},
+        {"colour_radius", "m", 0.0, 50.0, &C::colour_radius, "cones within this vote on the colour factor"},
+        {"width_min", "m", 0.0, 20.0, &C::width_min, "full width reward from"},
+        {"width_max", "m", 0.0, 20.0, &C::width_max, "full width reward up to"},
+        {"width_sigma", "m", 0.01, 10.0, &C::width_sigma, "Gaussian edges of the width reward"},
+        {"angle_sigma", "rad", 0.01, 10.0, &C::angle_sigma, "scale of the angle factor"},
+        {"step_preferred", "m", 0.0, 50.0, &C::step_preferred, "the typical step"},
+        {"step_sigma", "m", 0.01, 50.0, &C::step_sigma, "scale of the step factor"},
+        {"prediction_sigma", "m", 0.01, 50.0, &C::prediction_sigma, "scale of the prediction factor"},
+        {"min_reward", "", -10.0, 10.0, &C::min_reward, "a step below this reward is not taken"},
+        {"min_horizon_reward", "", -10.0, 10.0, &C::min_horizon_reward, "stop when the best continuation averages below this"},
+        {"closure_min_length", "m", 0.0, 10000.0, &C::closure_min_length, "a loop closes only after this length"},
+        {"closure_max_angle", "rad", 0.0, 3.2, &C::closure_max_angle, "largest heading difference at a loop closure"},
+    };
+    for (const Key& k : keys) {
+      const auto m = k.member;
+      f.push_back(real_field("planning", k.key, k.unit, k.lo, k.hi, k.doc, [m](auto& s) -> auto& { return s.planning.search.*m; }));
+    }
+    f.push_back(int_field("planning", "horizon_depth", "", 1, 10, "event horizon: steps evaluated before committing", ACC(planning.search.horizon_depth)));
+    f.push_back(int_field("planning", "first_beam_width", "", 1, 50, "event horizon: first steps kept", ACC(planning.search.first_beam_width)));
+    f.push_back(int_field("planning", "beam_width", "", 1, 50, "event horizon: continuations kept per step", ACC(planning.search.beam_width)));
+    f.push_back(int_field("planning", "smoothing_window", "", 1, 99, "moving-average window (odd)", ACC(planning.smoothing.window)));
+    f.push_back(real_field("planning", "opheim_min_tol", "m", 0.0, 10.0, "Opheim radial and perpendicular tolerance", ACC(planning.smoothing.opheim_min_tol)));
+    f.push_back(real_field("planning", "opheim_max_tol", "m", 0.0, 1000.0, "Opheim largest step", ACC(planning.smoothing.opheim_max_tol)));
+    f.push_back(enum_field<planning::SmoothingParams::Method>(
+        "planning", "smoothing", "centreline smoothing",
+        {{"combined", planning::SmoothingParams::Combined}, {"moving_average", planning::SmoothingParams::MovingAverage},
+         {"opheim", planning::SmoothingParams::Opheim}, {"raw", planning::SmoothingParams::Raw}},
+        ACC(planning.smoothing.method)));
+    f.push_back(real_field("planning", "clearance", "m", 0.0, 5.0, "planned path points stay this far from cone centres",
+                           ACC(planning.clearance.clearance)));
+  }
+
   // [mission]
   f.push_back(real_field("mission", "stop_decel", "m/s^2", 0.1, 50.0, "deceleration of the stop after the finish", ACC(mission.stop_decel)));
   f.push_back(real_field("mission", "standstill_speed", "m/s", 0.0, 5.0, "below this the stack counts as stopped",
@@ -426,6 +479,7 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   }
   if (const char* why = control::validate(s.control, stack_params(s).vehicle)) throw UserError(path + ": [control] " + why);
   if (const std::string why = sensors::validate(s.perception); !why.empty()) throw UserError(path + ": [perception] " + why);
+  if (const auto why = planning::validate(s.planning)) throw UserError(path + ": [planning] " + *why);
 
   s.source = path;
   s.name = std::filesystem::path(path).stem().string();
