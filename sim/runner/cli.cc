@@ -6,6 +6,7 @@
 
 #include "sim/runner/files.h"
 #include "sim/runner/plots.h"
+#include "sim/runner/reports.h"
 #include "sim/runner/report.h"
 #include "sim/runner/scenario.h"
 #include "sim/runner/simulation.h"
@@ -28,6 +29,10 @@ const char* kUsage =
     "      run's scenario.ini, log.csv and summary.json\n"
     "  plot options: --map-size N (px, default 1600), --chart-size WxH (default\n"
     "      1600x1200), --dpi D (default 150: text and lines are sized in points)\n"
+    "  paddock report controllers SCENARIO.ini [--set section.key=value]...\n"
+    "      Table I of the paper: the scenario with each lateral controller, as Markdown\n"
+    "  paddock report smoothing TRACK.csv\n"
+    "      Table II of the paper: four smoothings of the track's planned centreline\n"
     "  paddock check-track FILE...\n"
     "      loads, validates and describes track CSV files\n";
 
@@ -117,6 +122,23 @@ int cmd_run(const std::vector<std::string>& args) {
   return failed.empty() ? 0 : 3;
 }
 
+int cmd_report(const std::vector<std::string>& args) {
+  if (args.size() >= 2 && args[0] == "smoothing" && args.size() == 2) {
+    std::cout << report_smoothing(args[1]);
+    return 0;
+  }
+  if (args.size() >= 2 && args[0] == "controllers") {
+    std::vector<std::string> overrides;
+    for (std::size_t i = 2; i < args.size(); ++i) {
+      if (args[i] == "--set" && i + 1 < args.size()) overrides.push_back(args[++i]);
+      else throw UserError("report controllers: unexpected argument " + args[i] + "\n" + kUsage);
+    }
+    std::cout << report_controllers(args[1], overrides);
+    return 0;
+  }
+  throw UserError(std::string("report needs 'controllers SCENARIO' or 'smoothing TRACK'\n") + kUsage);
+}
+
 int cmd_plot(const std::vector<std::string>& args) {
   std::string dir;
   PlotOptions options;
@@ -159,6 +181,7 @@ int run_cli(const std::vector<std::string>& args) {
     if (args[0] == "run") return cmd_run(rest);
     if (args[0] == "check-track") return cmd_check_track(rest);
     if (args[0] == "plot") return cmd_plot(rest);
+    if (args[0] == "report") return cmd_report(rest);
     throw UserError("unknown command '" + args[0] + "'\n" + kUsage);
   } catch (const std::exception& e) {
     // user errors (and track errors) carry their file:line already
