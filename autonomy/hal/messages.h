@@ -1,6 +1,7 @@
 #pragma once
 // what crosses the HAL: timestamped sensor messages in, actuator commands out.
 // The sim back end and the hardware back end produce exactly these.
+#include <array>
 #include <variant>
 #include <vector>
 
@@ -44,7 +45,28 @@ struct ConeDetections {
   std::vector<DetectedCone> cones;
 };
 
-using SensorMessage = std::variant<StateEstimate, ResSignal, ConeDetections>;
+// the inertial measurement unit: planar specific force and yaw rate in the
+// base frame's orientation, at the IMU's mounting point
+struct Imu {
+  TimeNs stamp = 0;
+  double ax = 0.0;        // m/s^2, forward
+  double ay = 0.0;        // m/s^2, left
+  double yaw_rate = 0.0;  // rad/s
+};
+
+// the four wheels' angular speeds: front left, front right, rear left, rear right
+struct WheelSpeeds {
+  TimeNs stamp = 0;
+  std::array<double, 4> omega{};  // rad/s
+};
+
+// the measured road-wheel steering angle
+struct SteeringAngle {
+  TimeNs stamp = 0;
+  double angle = 0.0;  // rad, > 0 left
+};
+
+using SensorMessage = std::variant<StateEstimate, ResSignal, ConeDetections, Imu, WheelSpeeds, SteeringAngle>;
 
 // the stack's command to the car's low-level controllers
 struct ActuatorCommand {

@@ -164,6 +164,26 @@ void add_perception_fields(std::vector<Field>& f) {
   f.push_back(real_field("perception", "rate", "Hz", 0.1, 1000.0, "frames per second", ACC(perception.rate)));
 }
 
+// [imu], [wheel_speeds], [steering_sensor]: the odometry sensors
+void add_odometry_fields(std::vector<Field>& f) {
+  f.push_back(real_field("imu", "rate", "Hz", 1.0, 10000.0, "samples per second", ACC(imu.rate)));
+  f.push_back(real_field("imu", "accel_noise", "m/s^2", 0.0, 100.0, "accelerometer noise std per sample", ACC(imu.accel_noise)));
+  f.push_back(real_field("imu", "gyro_noise", "rad/s", 0.0, 10.0, "gyro noise std per sample", ACC(imu.gyro_noise)));
+  f.push_back(real_field("imu", "accel_bias_walk", "m/s^2/sqrt(s)", 0.0, 10.0, "accelerometer bias random walk", ACC(imu.accel_bias_walk)));
+  f.push_back(real_field("imu", "gyro_bias_walk", "rad/s/sqrt(s)", 0.0, 10.0, "gyro bias random walk", ACC(imu.gyro_bias_walk)));
+  f.push_back(real_field("imu", "accel_bias_initial_std", "m/s^2", 0.0, 10.0, "turn-on accelerometer bias std", ACC(imu.accel_bias_initial_std)));
+  f.push_back(real_field("imu", "gyro_bias_initial_std", "rad/s", 0.0, 10.0, "turn-on gyro bias std", ACC(imu.gyro_bias_initial_std)));
+  f.push_back(real_field("imu", "mount_x", "m", -10.0, 10.0, "IMU position ahead of the rear axle", ACC(imu.mount_x)));
+  f.push_back(real_field("imu", "mount_y", "m", -5.0, 5.0, "IMU position left of the centre", ACC(imu.mount_y)));
+  f.push_back(real_field("wheel_speeds", "rate", "Hz", 1.0, 10000.0, "samples per second", ACC(wheel_speeds.rate)));
+  f.push_back(real_field("wheel_speeds", "noise", "rad/s", 0.0, 100.0, "noise std", ACC(wheel_speeds.noise)));
+  f.push_back(real_field("wheel_speeds", "resolution", "rad/s", 0.0, 100.0, "quantisation step (0: none)", ACC(wheel_speeds.resolution)));
+  f.push_back(real_field("steering_sensor", "rate", "Hz", 1.0, 10000.0, "samples per second", ACC(steering_sensor.rate)));
+  f.push_back(real_field("steering_sensor", "noise", "rad", 0.0, 1.0, "noise std", ACC(steering_sensor.noise)));
+  f.push_back(real_field("steering_sensor", "resolution", "rad", 0.0, 1.0, "quantisation step (0: none)", ACC(steering_sensor.resolution)));
+  f.push_back(real_field("steering_sensor", "offset", "rad", -1.5, 1.5, "calibration offset", ACC(steering_sensor.offset)));
+}
+
 // [cones]: the Box2D cone world's physics
 void add_cone_fields(std::vector<Field>& f) {
   f.push_back(real_field("cones", "small_mass", "kg", 0.01, 100.0, "small cone mass", ACC(cones.small_cone.mass)));
@@ -348,6 +368,7 @@ std::vector<Field> build_fields() {
 
   // [perception], [vehicle] and [cones]: see add_perception_fields, add_vehicle_fields and add_cone_fields
   add_perception_fields(f);
+  add_odometry_fields(f);
   add_vehicle_fields(f);
   add_cone_fields(f);
 
@@ -480,6 +501,9 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   if (const char* why = control::validate(s.control, stack_params(s).vehicle)) throw UserError(path + ": [control] " + why);
   if (const std::string why = sensors::validate(s.perception); !why.empty()) throw UserError(path + ": [perception] " + why);
   if (const auto why = planning::validate(s.planning)) throw UserError(path + ": [planning] " + *why);
+  if (const std::string why = sensors::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
+  if (const std::string why = sensors::validate(s.wheel_speeds); !why.empty()) throw UserError(path + ": [wheel_speeds] " + why);
+  if (const std::string why = sensors::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
 
   s.source = path;
   s.name = std::filesystem::path(path).stem().string();

@@ -10,6 +10,8 @@
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
 #include "sim/sensors/cone_sensor.h"
+#include "sim/sensors/imu.h"
+#include "sim/sensors/odometry_sensors.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
 #include "sim/world/track.h"
@@ -55,6 +57,9 @@ struct Scenario {
   ScenarioSection scenario;
   stack::AutonomyModes autonomy;
   sensors::ConeSensorParams perception;  // the cone sensor of perception = ground_truth
+  sensors::ImuParams imu;                 // [imu]
+  sensors::WheelSpeedParams wheel_speeds;  // [wheel_speeds]
+  sensors::SteeringSensorParams steering_sensor;  // [steering_sensor]
   vehicle::VehicleParams vehicle;
   control::ControlParams control;
   planning::PathPlannerParams planning;

@@ -6,6 +6,8 @@
 
 #include "sim/runner/sim_hal.h"
 #include "sim/sensors/cone_sensor.h"
+#include "sim/sensors/imu.h"
+#include "sim/sensors/odometry_sensors.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
 
@@ -140,6 +142,14 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   std::vector<Cone> seen(static_cast<std::size_t>(cones.cone_count()));
   std::vector<bool> knocked(seen.size());
 
+  // the odometry sensors, each on its own random stream of the seed
+  sensors::Imu imu(sc.imu, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 2);
+  sensors::WheelSpeedSensor wheels(sc.wheel_speeds, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 3);
+  sensors::SteeringSensor steering(sc.steering_sensor, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 4);
+  auto every = [&](double rate) { return std::max(1L, std::lround(sc.sim.physics_rate / rate)); };
+  const long imu_every = every(sc.imu.rate), wheels_every = every(sc.wheel_speeds.rate),
+             steering_every = every(sc.steering_sensor.rate);
+
   vehicle::DriverInput input{0.0, 0.0, 1.0};
   hal::AsState as = hal::AsState::Off;
   const TimeNs go_ns = from_seconds(sc.scenario.go_time);
@@ -161,6 +171,23 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
         knocked[u] = cones.cone_knocked(i);
       }
       in_flight.emplace_back(now + sensor.latency_ns(), sensor.measure(seen, knocked, base, now));
+    }
+
+    // odometry: the IMU at the base origin's acceleration (from the CG's: a_base = a_cg
+    // + alpha x r - omega^2 r with r = (-lr, 0)), wheel speeds, the steering angle
+    if (k % imu_every == 0) {
+      const double ax_base = car.ax + car.r * car.r * vp.lr;
+      const double ay_base = car.ay - car.yaw_accel * vp.lr;
+      const sensors::ImuSample m = imu.measure(ax_base, ay_base, car.r, car.yaw_accel, now);
+      hal.post(hal::Imu{m.stamp, m.ax, m.ay, m.gz});
+    }
+    if (k % wheels_every == 0) {
+      const sensors::WheelSpeedSample m = wheels.measure(vehicle::wheel_speeds(vp, car), now);
+      hal.post(hal::WheelSpeeds{m.stamp, m.omega});
+    }
+    if (k % steering_every == 0) {
+      const sensors::SteeringSample m = steering.measure(car.steering, now);
+      hal.post(hal::SteeringAngle{m.stamp, m.angle});
     }
 
     // the control cycle: sensors into the HAL, the stack, its command to the actuators
