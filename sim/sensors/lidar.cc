@@ -1,0 +1,324 @@
+#include "sim/sensors/lidar.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace paddock::sensors {
+
+namespace {
+
+bool finite(double v) { return std::isfinite(v); }
+
+const char* error_name(RTCError e) {
+  switch (e) {
+    case RTC_ERROR_NONE: return "none";
+    case RTC_ERROR_UNKNOWN: return "unknown";
+    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+    case RTC_ERROR_CANCELLED: return "cancelled";
+  }
+  return "?";
+}
+
+void check(RTCDevice device, const char* what) {
+  const RTCError e = rtcGetDeviceError(device);
+  if (e != RTC_ERROR_NONE) {
+    throw LidarError(std::string("LidarWorld: Embree error in ") + what + ": " + error_name(e));
+  }
+}
+
+constexpr int kConeVertices = 2 * kConeSegments + 1;  // base ring, top ring, top centre
+constexpr int kConeTriangles = 3 * kConeSegments;     // lateral quads (2 each), top fan
+
+constexpr float kConeIntensity = 0.5f;
+constexpr float kGroundIntensity = 0.1f;
+
+}  // namespace
+
+std::string validate(const LidarParams& p) {
+  std::ostringstream os;
+  const double half_pi = 0.5 * kPi;
+  if (p.channels < 1 || p.channels > 65535) {
+    os << "channels must be in [1, 65535] (got " << p.channels << ")";
+  } else if (!finite(p.elevation_min) || !(p.elevation_min > -half_pi)) {
+    os << "elevation_min must be finite and > -pi/2 (got " << p.elevation_min << ")";
+  } else if (!finite(p.elevation_max) || !(p.elevation_max < half_pi)) {
+    os << "elevation_max must be finite and < pi/2 (got " << p.elevation_max << ")";
+  } else if (p.channels > 1 ? !(p.elevation_max > p.elevation_min)
+                            : !(p.elevation_max >= p.elevation_min)) {
+    os << "elevation_max must be > elevation_min (got " << p.elevation_max
+       << " <= " << p.elevation_min << ")";
+  } else if (p.columns < 1) {
+    os << "columns must be >= 1 (got " << p.columns << ")";
+  } else if (!finite(p.rate) || !(p.rate > 0.0)) {
+    os << "rate must be finite and > 0 (got " << p.rate << ")";
+  } else if (!finite(p.range_min) || !(p.range_min >= 0.0)) {
+    os << "range_min must be finite and >= 0 (got " << p.range_min << ")";
+  } else if (!finite(p.range_max) || !(p.range_max > p.range_min)) {
+    os << "range_max must be finite and > range_min (got " << p.range_max
+       << " <= " << p.range_min << ")";
+  } else if (!finite(p.range_noise) || !(p.range_noise >= 0.0)) {
+    os << "range_noise must be finite and >= 0 (got " << p.range_noise << ")";
+  } else if (!finite(p.dropout) || !(p.dropout >= 0.0 && p.dropout < 1.0)) {
+    os << "dropout must be in [0, 1) (got " << p.dropout << ")";
+  } else if (!finite(p.mount_x) || !finite(p.mount_y) || !finite(p.mount_z)) {
+    os << "mount_x, mount_y and mount_z must be finite";
+  } else if (!finite(p.mount_pitch) || !(std::abs(p.mount_pitch) < half_pi)) {
+    os << "mount_pitch must be in (-pi/2, pi/2) (got " << p.mount_pitch << ")";
+  }
+  return os.str();
+}
+
+// ---------------------------------------------------------------- LidarWorld
+
+LidarWorld::LidarWorld(const std::vector<Cone>& cones) {
+  // one worker thread: many simulations may run side by side in one process
+  device_ = rtcNewDevice("threads=1");
+  if (device_ == nullptr) {
+    throw LidarError(std::string("LidarWorld: rtcNewDevice failed: ") +
+                     error_name(rtcGetDeviceError(nullptr)));
+  }
+  try {
+    scene_ = rtcNewScene(device_);
+    check(device_, "rtcNewScene");
+    rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
+
+    // the cones' bounding box, for the ground quad
+    double lo_x = 0.0, lo_y = 0.0, hi_x = 0.0, hi_y = 0.0;
+    bool any = false;
+    for (std::size_t i = 0; i < cones.size(); ++i) {
+      const Vec2 p = cones[i].position;
+      if (!finite(p.x) || !finite(p.y)) continue;
+      if (!any) {
+        lo_x = hi_x = p.x;
+        lo_y = hi_y = p.y;
+        any = true;
+      }
+      lo_x = std::min(lo_x, p.x);
+      hi_x = std::max(hi_x, p.x);
+      lo_y = std::min(lo_y, p.y);
+      hi_y = std::max(hi_y, p.y);
+      cone_of_mesh_.push_back(static_cast<std::int32_t>(i));
+    }
+    cone_count_ = cones.size();
+
+    // ground: two triangles at z = 0
+    {
+      RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+      check(device_, "rtcNewGeometry(ground)");
+      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 4));
+      auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), 2));
+      check(device_, "rtcSetNewGeometryBuffer(ground)");
+      const double m = kGroundMargin;
+      const float x0 = static_cast<float>(lo_x - m), x1 = static_cast<float>(hi_x + m);
+      const float y0 = static_cast<float>(lo_y - m), y1 = static_cast<float>(hi_y + m);
+      const float quad[12] = {x0, y0, 0.0f, x1, y0, 0.0f, x1, y1, 0.0f, x0, y1, 0.0f};
+      std::copy(quad, quad + 12, v);
+      const unsigned tris[6] = {0, 1, 2, 0, 2, 3};
+      std::copy(tris, tris + 6, idx);
+      rtcCommitGeometry(g);
+      ground_geom_ = rtcAttachGeometry(scene_, g);
+      rtcReleaseGeometry(g);
+      check(device_, "ground geometry");
+    }
+
+    // cones: one triangle mesh, kConeTriangles per cone, in cone_of_mesh_ order
+    if (!cone_of_mesh_.empty()) {
+      const std::size_t n = cone_of_mesh_.size();
+      RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+      check(device_, "rtcNewGeometry(cones)");
+      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+          n * kConeVertices));
+      auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+          n * kConeTriangles));
+      check(device_, "rtcSetNewGeometryBuffer(cones)");
+      for (std::size_t k = 0; k < n; ++k) {
+        const Cone& c = cones[static_cast<std::size_t>(cone_of_mesh_[k])];
+        const bool big = c.color == ConeColor::BigOrange;
+        const double r0 = 0.5 * (big ? kBigConeBaseWidth : kSmallConeBaseWidth);
+        const double h = big ? kBigConeHeight : kSmallConeHeight;
+        float* vk = v + 3 * kConeVertices * k;
+        for (int s = 0; s < kConeSegments; ++s) {
+          const double a = 2.0 * kPi * s / kConeSegments;
+          const double ca = std::cos(a), sa = std::sin(a);
+          float* b = vk + 3 * s;
+          b[0] = static_cast<float>(c.position.x + r0 * ca);
+          b[1] = static_cast<float>(c.position.y + r0 * sa);
+          b[2] = 0.0f;
+          float* t = vk + 3 * (kConeSegments + s);
+          t[0] = static_cast<float>(c.position.x + kConeApexRadius * ca);
+          t[1] = static_cast<float>(c.position.y + kConeApexRadius * sa);
+          t[2] = static_cast<float>(h);
+        }
+        float* top = vk + 3 * (2 * kConeSegments);
+        top[0] = static_cast<float>(c.position.x);
+        top[1] = static_cast<float>(c.position.y);
+        top[2] = static_cast<float>(h);
+        const auto base = static_cast<unsigned>(kConeVertices * k);
+        unsigned* ik = idx + 3 * kConeTriangles * k;
+        const auto segs = static_cast<unsigned>(kConeSegments);
+        for (unsigned s = 0; s < segs; ++s) {
+          const unsigned s1 = (s + 1) % segs;
+          const unsigned b0 = base + s, b1 = base + s1;
+          const unsigned t0 = base + segs + s, t1 = base + segs + s1;
+          const unsigned ctr = base + 2 * segs;
+          unsigned* q = ik + 9 * s;
+          q[0] = b0; q[1] = b1; q[2] = t1;   // lateral, lower
+          q[3] = b0; q[4] = t1; q[5] = t0;   // lateral, upper
+          q[6] = t0; q[7] = t1; q[8] = ctr;  // top fan
+        }
+      }
+      rtcCommitGeometry(g);
+      cone_geom_ = rtcAttachGeometry(scene_, g);
+      rtcReleaseGeometry(g);
+      check(device_, "cone geometry");
+    }
+
+    rtcCommitScene(scene_);
+    check(device_, "rtcCommitScene");
+  } catch (...) {
+    if (scene_ != nullptr) rtcReleaseScene(scene_);
+    rtcReleaseDevice(device_);
+    throw;
+  }
+}
+
+LidarWorld::~LidarWorld() {
+  if (scene_ != nullptr) rtcReleaseScene(scene_);
+  if (device_ != nullptr) rtcReleaseDevice(device_);
+}
+
+std::int32_t LidarWorld::cone_of(unsigned geom_id, unsigned prim_id) const {
+  if (geom_id == RTC_INVALID_GEOMETRY_ID) return -2;
+  if (geom_id == ground_geom_) return -1;
+  if (geom_id == cone_geom_) {
+    const std::size_t k = prim_id / static_cast<unsigned>(kConeTriangles);
+    if (k < cone_of_mesh_.size()) return cone_of_mesh_[k];
+  }
+  return -2;
+}
+
+// --------------------------------------------------------------------- Lidar
+
+Lidar::Lidar(const LidarParams& params, std::uint64_t seed) : params_(params), rng_(seed) {
+  const std::string err = validate(params_);
+  if (!err.empty()) throw std::invalid_argument("LidarParams: " + err);
+  const auto nch = static_cast<std::size_t>(params_.channels);
+  const auto ncol = static_cast<std::size_t>(params_.columns);
+  cos_el_.resize(nch);
+  sin_el_.resize(nch);
+  for (std::size_t i = 0; i < nch; ++i) {
+    const double e = params_.elevation_min + static_cast<double>(i) * vertical_resolution();
+    cos_el_[i] = std::cos(e);
+    sin_el_[i] = std::sin(e);
+  }
+  cos_az_.resize(ncol);
+  sin_az_.resize(ncol);
+  for (std::size_t c = 0; c < ncol; ++c) {
+    const double a = -kPi + static_cast<double>(c) * horizontal_resolution();
+    cos_az_[c] = std::cos(a);
+    sin_az_[c] = std::sin(a);
+  }
+}
+
+double Lidar::vertical_resolution() const {
+  return params_.channels > 1
+             ? (params_.elevation_max - params_.elevation_min) / (params_.channels - 1)
+             : 0.0;
+}
+
+double Lidar::horizontal_resolution() const { return 2.0 * kPi / params_.columns; }
+
+TimeNs Lidar::column_time(TimeNs start, int c) const {
+  return start + period_ns() * c / params_.columns;
+}
+
+std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
+                                    const std::function<Pose2(TimeNs)>& base_pose_at,
+                                    TimeNs start) {
+  std::vector<LidarPoint> out;
+  const int nch = params_.channels;
+  out.reserve(static_cast<std::size_t>(nch) * static_cast<std::size_t>(params_.columns) / 2);
+  const double cp = std::cos(params_.mount_pitch), sp = std::sin(params_.mount_pitch);
+  const float tfar = static_cast<float>(params_.range_max + 6.0 * params_.range_noise + 0.01);
+  const bool noisy = params_.range_noise > 0.0;
+  const bool drops = params_.dropout > 0.0;
+
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+
+  for (int c = 0; c < params_.columns; ++c) {
+    const TimeNs t = column_time(start, c);
+    const Pose2 pose = base_pose_at(t);
+    if (!finite(pose.x) || !finite(pose.y) || !finite(pose.yaw)) continue;
+    const double cy = std::cos(pose.yaw), sy = std::sin(pose.yaw);
+    const Vec2 origin = pose.transform({params_.mount_x, params_.mount_y});
+    const auto cu = static_cast<std::size_t>(c);
+    const double ca = cos_az_[cu], sa = sin_az_[cu];
+    // the column's channels in packets of 16 rays (coherent: one origin, one azimuth)
+    for (int ch0 = 0; ch0 < nch; ch0 += 16) {
+      const int n = std::min(16, nch - ch0);
+      alignas(64) int valid[16];
+      alignas(64) RTCRayHit16 rh;
+      double dirs[16][3];
+      for (int j = 0; j < 16; ++j) {
+        valid[j] = j < n ? -1 : 0;
+        const auto chu = static_cast<std::size_t>(ch0 + std::min(j, n - 1));
+        // direction in the sensor frame
+        const double dx = cos_el_[chu] * ca, dy = cos_el_[chu] * sa, dz = sin_el_[chu];
+        dirs[j][0] = dx;
+        dirs[j][1] = dy;
+        dirs[j][2] = dz;
+        // pitch about the sensor's y, then the base's yaw
+        const double px = cp * dx + sp * dz, pz = -sp * dx + cp * dz;
+        rh.ray.org_x[j] = static_cast<float>(origin.x);
+        rh.ray.org_y[j] = static_cast<float>(origin.y);
+        rh.ray.org_z[j] = static_cast<float>(params_.mount_z);
+        rh.ray.dir_x[j] = static_cast<float>(cy * px - sy * dy);
+        rh.ray.dir_y[j] = static_cast<float>(sy * px + cy * dy);
+        rh.ray.dir_z[j] = static_cast<float>(pz);
+        rh.ray.tnear[j] = 0.0f;
+        rh.ray.tfar[j] = tfar;
+        rh.ray.time[j] = 0.0f;
+        rh.ray.mask[j] = 0xFFFFFFFFu;
+        rh.ray.id[j] = static_cast<unsigned>(j);
+        rh.ray.flags[j] = 0;
+        rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][j] = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect16(valid, world.scene(), &context, &rh);
+
+      for (int j = 0; j < n; ++j) {
+        if (rh.hit.geomID[j] == RTC_INVALID_GEOMETRY_ID) continue;
+        const std::int32_t cone = world.cone_of(rh.hit.geomID[j], rh.hit.primID[j]);
+        if (cone < -1) continue;
+
+        if (drops && uniform_(rng_) < params_.dropout) continue;
+        double r = static_cast<double>(rh.ray.tfar[j]);  // |dir| = 1: tfar is the range
+        if (noisy) r += params_.range_noise * normal_(rng_);
+        if (r < params_.range_min || r > params_.range_max) continue;
+
+        LidarPoint p;
+        p.x = static_cast<float>(r * dirs[j][0]);
+        p.y = static_cast<float>(r * dirs[j][1]);
+        p.z = static_cast<float>(r * dirs[j][2]);
+        p.intensity = cone >= 0 ? kConeIntensity : kGroundIntensity;
+        p.ring = static_cast<std::uint16_t>(ch0 + j);
+        p.t = t;
+        p.cone = cone;
+        out.push_back(p);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace paddock::sensors

@@ -1,0 +1,151 @@
+#pragma once
+// a rotating multi-channel LiDAR, ray-cast with Embree 3 against cone meshes of
+// their real size standing on a flat ground plane (z = 0).
+//
+// Model (LidarParams) + the scene (LidarWorld: the Embree device and scene,
+// built once from the cones) + a small class holding only its random stream
+// (Lidar). No I/O, no clock, no global state: scan() is a pure function of the
+// world, the pose trajectory, the start time and the stream's state.
+//
+// The sensor frame `lidar`: origin at the optical centre, x forward, y left,
+// z up (REP-103), mounted in the base frame at (mount_x, mount_y, mount_z) with
+// the yaw of the base and a pitch mount_pitch about its y axis (> 0 tilts the
+// nose down). The head spins counter-clockwise seen from above; column c looks
+// at azimuth -pi + 2 pi c / columns in the sensor frame (column 0 looks
+// backwards, column columns/2 straight ahead, so the seam of a rotation lies
+// behind the car, where its body hides the view anyway).
+//
+// Not modelled yet: the intensity material model (stripes, fall-off with range
+// and incidence): intensity is a constant per hit type; knocked cones (lying on
+// their side); sloped or bumpy ground.
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <embree3/rtcore.h>
+
+#include "autonomy/common/cone.h"
+#include "autonomy/common/geometry.h"
+#include "autonomy/common/time.h"
+
+namespace paddock::sensors {
+
+struct LidarParams {
+  // channels, evenly spaced in elevation from elevation_min to elevation_max
+  // (both included). 32 channels over -16 .. +15 deg: a 1 deg vertical
+  // resolution, a common 32-beam FS LiDAR layout.
+  int channels = 32;                               // -, in [1, 65535]
+  double elevation_min = -16.0 * kPi / 180.0;      // rad
+  double elevation_max = 15.0 * kPi / 180.0;       // rad
+  // columns per rotation: 1024 gives a 6.1 mrad horizontal resolution
+  int columns = 1024;  // -
+  // rotation rate; DESIGN.md's LiDAR rate
+  double rate = 10.0;  // Hz
+  // range limits: 0.5 m blind zone of common FS LiDARs; 50 m far beyond where
+  // a cone still gets more than a point or two
+  double range_min = 0.5;   // m
+  double range_max = 50.0;  // m
+  // Gaussian range noise std along the ray; the paper quotes 2-3 cm
+  double range_noise = 0.02;  // m
+  // probability that a ray returns nothing
+  double dropout = 0.0;  // -, in [0, 1)
+  // mounting in the base frame: on the nose cone, low, as in the paper
+  // (about 0.7 m ahead of the front axle of a 1.53 m wheelbase)
+  double mount_x = 2.2;       // m
+  double mount_y = 0.0;       // m
+  double mount_z = 0.15;      // m, above the ground
+  double mount_pitch = 0.0;   // rad, > 0 nose down
+};
+
+// "" when every field is usable, else the first problem, starting with the
+// field name
+std::string validate(const LidarParams& p);
+
+// an Embree failure (device creation, buffer allocation, scene commit)
+class LidarError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// the real FS cone sizes (ORACLES.md): a cone mesh is a truncated cone of
+// kConeSegments facets standing on its base, vertices on the true circles
+inline constexpr double kSmallConeBaseWidth = 0.228;  // m
+inline constexpr double kSmallConeHeight = 0.325;     // m
+inline constexpr double kBigConeBaseWidth = 0.285;    // m
+inline constexpr double kBigConeHeight = 0.505;       // m
+inline constexpr double kConeApexRadius = 0.03;       // m, the flat top
+inline constexpr int kConeSegments = 16;
+
+// the static scene: cones (BigOrange big, every other colour small) and a flat
+// ground quad at z = 0 that extends kGroundMargin past the cones' bounding box.
+// Owns the Embree device and scene; non-copyable, non-movable.
+class LidarWorld {
+ public:
+  static constexpr double kGroundMargin = 500.0;  // m
+  // throws LidarError on an Embree failure. Cones with a non-finite position
+  // are left out (and are never reported as hit).
+  explicit LidarWorld(const std::vector<Cone>& cones);
+  ~LidarWorld();
+  LidarWorld(const LidarWorld&) = delete;
+  LidarWorld& operator=(const LidarWorld&) = delete;
+
+  RTCScene scene() const { return scene_; }
+  std::size_t cone_count() const { return cone_count_; }
+  // the cone index hit by (geomID, primID), -1 for the ground, -2 for nothing
+  std::int32_t cone_of(unsigned geom_id, unsigned prim_id) const;
+
+ private:
+  RTCDevice device_ = nullptr;
+  RTCScene scene_ = nullptr;
+  std::size_t cone_count_ = 0;
+  unsigned ground_geom_ = RTC_INVALID_GEOMETRY_ID;
+  unsigned cone_geom_ = RTC_INVALID_GEOMETRY_ID;
+  std::vector<std::int32_t> cone_of_mesh_;  // mesh k (in the cone geometry) -> cone index
+};
+
+struct LidarPoint {
+  float x, y, z;        // m, sensor frame at the point's own time (x forward, y left, z up)
+  float intensity;      // -, [0, 1]; for now 0.5 on cones, 0.1 on the ground
+  std::uint16_t ring;   // channel, 0 = lowest elevation
+  std::int64_t t;       // ns, the time of the point's column
+  std::int32_t cone;    // ground truth: cone index hit, -1 ground
+};
+
+class Lidar {
+ public:
+  // throws std::invalid_argument when validate(params) fails. The seed starts
+  // this sensor's own random stream (std::mt19937_64).
+  Lidar(const LidarParams& params, std::uint64_t seed);
+
+  // one rotation. Column c is cast at t_c = start + c * period / columns (integer
+  // ns) from the base pose base_pose_at(t_c), all channels at once; the rays
+  // start at the mounting point. Returns the hits whose measured range (true
+  // range + N(0, range_noise)) lies in [range_min, range_max], less the
+  // dropouts, column by column, rings ascending within a column, each in the
+  // sensor frame at its column's time. A column whose pose is not finite gives
+  // no points (an all-NaN trajectory gives an empty scan).
+  std::vector<LidarPoint> scan(const LidarWorld& world,
+                               const std::function<Pose2(TimeNs)>& base_pose_at, TimeNs start);
+
+  const LidarParams& params() const { return params_; }
+  TimeNs period_ns() const { return from_seconds(1.0 / params_.rate); }
+  // the time of column c of a scan starting at `start`
+  TimeNs column_time(TimeNs start, int c) const;
+  // the angular resolutions: vertical (channel spacing) and horizontal
+  double vertical_resolution() const;    // rad
+  double horizontal_resolution() const;  // rad
+
+ private:
+  LidarParams params_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  std::uniform_real_distribution<double> uniform_{0.0, 1.0};
+  // per channel: cos and sin of the elevation; per column: of the azimuth
+  std::vector<double> cos_el_, sin_el_, cos_az_, sin_az_;
+};
+
+}  // namespace paddock::sensors
