@@ -34,10 +34,40 @@ void check(RTCDevice device, const char* what) {
 constexpr int kConeVertices = 2 * kConeSegments + 1;  // base ring, top ring, top centre
 constexpr int kConeTriangles = 3 * kConeSegments;     // lateral quads (2 each), top fan
 
-constexpr float kConeIntensity = 0.5f;
-constexpr float kGroundIntensity = 0.1f;
+bool unit_interval(double v) { return finite(v) && v >= 0.0 && v <= 1.0; }
 
 }  // namespace
+
+LidarMaterial cone_material(ConeColor color, double f) {
+  const auto in = [f](double lo, double hi) { return f >= lo && f < hi; };
+  switch (color) {
+    case ConeColor::Blue:
+      return in(kSmallStripeLo, kSmallStripeHi) ? LidarMaterial::White : LidarMaterial::Blue;
+    case ConeColor::Yellow:
+      return in(kSmallStripeLo, kSmallStripeHi) ? LidarMaterial::Black : LidarMaterial::Yellow;
+    case ConeColor::SmallOrange:
+      return in(kSmallStripeLo, kSmallStripeHi) ? LidarMaterial::White : LidarMaterial::Orange;
+    case ConeColor::BigOrange:
+      return in(kBigStripe1Lo, kBigStripe1Hi) || in(kBigStripe2Lo, kBigStripe2Hi)
+                 ? LidarMaterial::White
+                 : LidarMaterial::Orange;
+    case ConeColor::Unknown: return LidarMaterial::Grey;
+  }
+  return LidarMaterial::Grey;
+}
+
+double reflectivity(const LidarParams& p, LidarMaterial m) {
+  switch (m) {
+    case LidarMaterial::White: return p.reflect_white;
+    case LidarMaterial::Yellow: return p.reflect_yellow;
+    case LidarMaterial::Orange: return p.reflect_orange;
+    case LidarMaterial::Blue: return p.reflect_blue;
+    case LidarMaterial::Black: return p.reflect_black;
+    case LidarMaterial::Grey: return p.reflect_grey;
+    case LidarMaterial::Ground: return p.reflect_ground;
+  }
+  return 0.0;
+}
 
 std::string validate(const LidarParams& p) {
   std::ostringstream os;
@@ -69,13 +99,25 @@ std::string validate(const LidarParams& p) {
     os << "mount_x, mount_y and mount_z must be finite";
   } else if (!finite(p.mount_pitch) || !(std::abs(p.mount_pitch) < half_pi)) {
     os << "mount_pitch must be in (-pi/2, pi/2) (got " << p.mount_pitch << ")";
+  } else if (!unit_interval(p.reflect_white) || !unit_interval(p.reflect_yellow) ||
+             !unit_interval(p.reflect_orange) || !unit_interval(p.reflect_blue) ||
+             !unit_interval(p.reflect_black) || !unit_interval(p.reflect_grey) ||
+             !unit_interval(p.reflect_ground)) {
+    os << "reflect_* must all be in [0, 1]";
+  } else if (!finite(p.intensity_range_ref) || !(p.intensity_range_ref > 0.0)) {
+    os << "intensity_range_ref must be finite and > 0 (got " << p.intensity_range_ref << ")";
+  } else if (!finite(p.intensity_noise) || !(p.intensity_noise >= 0.0)) {
+    os << "intensity_noise must be finite and >= 0 (got " << p.intensity_noise << ")";
   }
   return os.str();
 }
 
 // ---------------------------------------------------------------- LidarWorld
 
-LidarWorld::LidarWorld(const std::vector<Cone>& cones) {
+LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked) {
+  if (!knocked.empty() && knocked.size() != cones.size()) {
+    throw std::invalid_argument("LidarWorld: knocked must be empty or of the size of cones");
+  }
   // one worker thread: many simulations may run side by side in one process
   device_ = rtcNewDevice("threads=1");
   if (device_ == nullptr) {
@@ -145,23 +187,28 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones) {
         const bool big = c.color == ConeColor::BigOrange;
         const double r0 = 0.5 * (big ? kBigConeBaseWidth : kSmallConeBaseWidth);
         const double h = big ? kBigConeHeight : kSmallConeHeight;
+        const bool down = !knocked.empty() && knocked[static_cast<std::size_t>(cone_of_mesh_[k])];
+        // the cone's local frame (x, y across, z along the axis from the base
+        // centre) to the world: standing, a translation; knocked, first a
+        // 90 deg rotation about y, (lx, ly, lz) -> (lz, ly, -lx), then the base
+        // centre to (px - h/2, py, r0)
+        const double ox = down ? c.position.x - 0.5 * h : c.position.x;
+        const double oz = down ? r0 : 0.0;
+        const auto put = [&](float* out, double lx, double ly, double lz) {
+          out[0] = static_cast<float>(ox + (down ? lz : lx));
+          out[1] = static_cast<float>(c.position.y + ly);
+          out[2] = static_cast<float>(oz + (down ? -lx : lz));
+        };
+        mesh_info_.push_back({c.color, h, ox, c.position.y, oz, down ? 1.0 : 0.0, 0.0,
+                              down ? 0.0 : 1.0});
         float* vk = v + 3 * kConeVertices * k;
         for (int s = 0; s < kConeSegments; ++s) {
           const double a = 2.0 * kPi * s / kConeSegments;
           const double ca = std::cos(a), sa = std::sin(a);
-          float* b = vk + 3 * s;
-          b[0] = static_cast<float>(c.position.x + r0 * ca);
-          b[1] = static_cast<float>(c.position.y + r0 * sa);
-          b[2] = 0.0f;
-          float* t = vk + 3 * (kConeSegments + s);
-          t[0] = static_cast<float>(c.position.x + kConeApexRadius * ca);
-          t[1] = static_cast<float>(c.position.y + kConeApexRadius * sa);
-          t[2] = static_cast<float>(h);
+          put(vk + 3 * s, r0 * ca, r0 * sa, 0.0);
+          put(vk + 3 * (kConeSegments + s), kConeApexRadius * ca, kConeApexRadius * sa, h);
         }
-        float* top = vk + 3 * (2 * kConeSegments);
-        top[0] = static_cast<float>(c.position.x);
-        top[1] = static_cast<float>(c.position.y);
-        top[2] = static_cast<float>(h);
+        put(vk + 3 * (2 * kConeSegments), 0.0, 0.0, h);
         const auto base = static_cast<unsigned>(kConeVertices * k);
         unsigned* ik = idx + 3 * kConeTriangles * k;
         const auto segs = static_cast<unsigned>(kConeSegments);
@@ -204,6 +251,19 @@ std::int32_t LidarWorld::cone_of(unsigned geom_id, unsigned prim_id) const {
     if (k < cone_of_mesh_.size()) return cone_of_mesh_[k];
   }
   return -2;
+}
+
+LidarMaterial LidarWorld::material_of(unsigned geom_id, unsigned prim_id, double x, double y,
+                                      double z) const {
+  if (geom_id == cone_geom_) {
+    const std::size_t k = prim_id / static_cast<unsigned>(kConeTriangles);
+    if (k < mesh_info_.size()) {
+      const MeshInfo& m = mesh_info_[k];
+      const double along = (x - m.ox) * m.ax + (y - m.oy) * m.ay + (z - m.oz) * m.az;
+      return cone_material(m.color, along / m.height);
+    }
+  }
+  return LidarMaterial::Ground;
 }
 
 // --------------------------------------------------------------------- Lidar
@@ -251,6 +311,7 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
   const float tfar = static_cast<float>(params_.range_max + 6.0 * params_.range_noise + 0.01);
   const bool noisy = params_.range_noise > 0.0;
   const bool drops = params_.dropout > 0.0;
+  const bool inoisy = params_.intensity_noise > 0.0;
 
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -302,15 +363,33 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
         if (cone < -1) continue;
 
         if (drops && uniform_(rng_) < params_.dropout) continue;
-        double r = static_cast<double>(rh.ray.tfar[j]);  // |dir| = 1: tfar is the range
+        const double r_true = static_cast<double>(rh.ray.tfar[j]);  // |dir| = 1: tfar is the range
+        double r = r_true;
         if (noisy) r += params_.range_noise * normal_(rng_);
         if (r < params_.range_min || r > params_.range_max) continue;
+
+        // intensity: material at the true hit point, incidence on the facet
+        const double wx = rh.ray.org_x[j] + r_true * rh.ray.dir_x[j];
+        const double wy = rh.ray.org_y[j] + r_true * rh.ray.dir_y[j];
+        const double wz = rh.ray.org_z[j] + r_true * rh.ray.dir_z[j];
+        const double rho = reflectivity(
+            params_, world.material_of(rh.hit.geomID[j], rh.hit.primID[j], wx, wy, wz));
+        const double nx = rh.hit.Ng_x[j], ny = rh.hit.Ng_y[j], nz = rh.hit.Ng_z[j];
+        const double nn = std::sqrt(nx * nx + ny * ny + nz * nz);
+        const double cos_inc =
+            nn > 0.0 ? std::abs(nx * rh.ray.dir_x[j] + ny * rh.ray.dir_y[j] +
+                                nz * rh.ray.dir_z[j]) / nn
+                     : 0.0;
+        const double q = params_.intensity_range_ref / std::max(r_true, 1e-9);
+        double intensity = rho * cos_inc * std::min(1.0, q * q);
+        if (inoisy) intensity += params_.intensity_noise * normal_(rng_);
+        intensity = std::clamp(intensity, 0.0, 1.0);
 
         LidarPoint p;
         p.x = static_cast<float>(r * dirs[j][0]);
         p.y = static_cast<float>(r * dirs[j][1]);
         p.z = static_cast<float>(r * dirs[j][2]);
-        p.intensity = cone >= 0 ? kConeIntensity : kGroundIntensity;
+        p.intensity = static_cast<float>(intensity);
         p.ring = static_cast<std::uint16_t>(ch0 + j);
         p.t = t;
         p.cone = cone;

@@ -15,9 +15,18 @@
 // backwards, column columns/2 straight ahead, so the seam of a rotation lies
 // behind the car, where its body hides the view anyway).
 //
-// Not modelled yet: the intensity material model (stripes, fall-off with range
-// and incidence): intensity is a constant per hit type; knocked cones (lying on
-// their side); sloped or bumpy ground.
+// Intensity: a material model. Each hit has a material (ConeMaterial: the cone's
+// stripes by height along its axis, or the asphalt ground) with a reflectivity
+// rho (LidarParams), and
+//   I = rho * cos(incidence) * min(1, (intensity_range_ref / r)^2) + N(0, intensity_noise)
+// clamped to [0, 1]; r is the true range, the incidence is taken against the
+// hit facet's geometric normal. The 1/r^2 law is the received power of an
+// extended Lambertian target that fills the beam (a cone face or the ground at
+// these ranges); below intensity_range_ref the receiver is taken as saturated.
+//
+// Knocked cones lie on their side (LidarWorld's `knocked`).
+//
+// Not modelled yet: sloped or bumpy ground.
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -59,6 +68,18 @@ struct LidarParams {
   double mount_y = 0.0;       // m
   double mount_z = 0.15;      // m, above the ground
   double mount_pitch = 0.0;   // rad, > 0 nose down
+  // intensity material model: reflectivities (diffuse, 905 nm, all in [0, 1])
+  double reflect_white = 0.9;    // white stripe (retro-ish white foil / paint)
+  double reflect_yellow = 0.6;   // yellow cone body
+  double reflect_orange = 0.5;   // orange cone body
+  double reflect_blue = 0.25;    // blue cone body
+  double reflect_black = 0.05;   // black stripe
+  double reflect_grey = 0.4;     // cones of unknown colour: plain grey
+  double reflect_ground = 0.15;  // asphalt
+  // range fall-off min(1, (intensity_range_ref / r)^2)
+  double intensity_range_ref = 5.0;  // m, > 0
+  // Gaussian intensity noise std (before clamping to [0, 1])
+  double intensity_noise = 0.01;  // -
 };
 
 // "" when every field is usable, else the first problem, starting with the
@@ -80,15 +101,46 @@ inline constexpr double kBigConeHeight = 0.505;       // m
 inline constexpr double kConeApexRadius = 0.03;       // m, the flat top
 inline constexpr int kConeSegments = 16;
 
+// the stripes, as fractions of the cone's height along its axis from the base,
+// after pictures of the FS cones: a small cone (325 mm) has one middle stripe
+// over 40 .. 60 % of its height (z = 130 .. 195 mm, a 65 mm band); a big orange
+// cone (505 mm) has two white stripes, 28 .. 42 % and 58 .. 72 % (141 .. 212 mm
+// and 293 .. 364 mm). The flat top has the body's colour.
+inline constexpr double kSmallStripeLo = 0.40;
+inline constexpr double kSmallStripeHi = 0.60;
+inline constexpr double kBigStripe1Lo = 0.28;
+inline constexpr double kBigStripe1Hi = 0.42;
+inline constexpr double kBigStripe2Lo = 0.58;
+inline constexpr double kBigStripe2Hi = 0.72;
+
+enum class LidarMaterial { White, Yellow, Orange, Blue, Black, Grey, Ground };
+
+// the material of a cone of colour `color` at `height_fraction` (0 = base,
+// 1 = top) of its height: blue with a white middle stripe, yellow with a black
+// one, small orange with a white one, big orange with two white ones, unknown
+// plain grey
+LidarMaterial cone_material(ConeColor color, double height_fraction);
+
+// the reflectivity p assigns to material m
+double reflectivity(const LidarParams& p, LidarMaterial m);
 // the static scene: cones (BigOrange big, every other colour small) and a flat
 // ground quad at z = 0 that extends kGroundMargin past the cones' bounding box.
 // Owns the Embree device and scene; non-copyable, non-movable.
+//
+// A standing cone stands on its base centred on its position. A knocked cone
+// (knocked[i] true) lies on its side: its mesh is rotated 90 deg about the
+// world y axis, so its axis is horizontal along the world +x axis (base at
+// -x, top at +x), at the height of its base radius (0.114 m small, 0.1425 m
+// big: the base rim touches the ground, the top end floats a little), the
+// middle of its axis above its position. It reaches up to its base width
+// (0.228 m small, 0.285 m big).
 class LidarWorld {
  public:
   static constexpr double kGroundMargin = 500.0;  // m
-  // throws LidarError on an Embree failure. Cones with a non-finite position
-  // are left out (and are never reported as hit).
-  explicit LidarWorld(const std::vector<Cone>& cones);
+  // throws LidarError on an Embree failure, std::invalid_argument when knocked
+  // is neither empty (no cone knocked) nor of the size of cones. Cones with a
+  // non-finite position are left out (and are never reported as hit).
+  explicit LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked = {});
   ~LidarWorld();
   LidarWorld(const LidarWorld&) = delete;
   LidarWorld& operator=(const LidarWorld&) = delete;
@@ -97,6 +149,11 @@ class LidarWorld {
   std::size_t cone_count() const { return cone_count_; }
   // the cone index hit by (geomID, primID), -1 for the ground, -2 for nothing
   std::int32_t cone_of(unsigned geom_id, unsigned prim_id) const;
+  // the material at the hit (geomID, primID) at world point (x, y, z): the
+  // ground's, or the cone's stripe at the point's height along the cone's axis.
+  // Only meaningful when cone_of(geom_id, prim_id) >= -1.
+  LidarMaterial material_of(unsigned geom_id, unsigned prim_id, double x, double y,
+                            double z) const;
 
  private:
   RTCDevice device_ = nullptr;
@@ -105,11 +162,19 @@ class LidarWorld {
   unsigned ground_geom_ = RTC_INVALID_GEOMETRY_ID;
   unsigned cone_geom_ = RTC_INVALID_GEOMETRY_ID;
   std::vector<std::int32_t> cone_of_mesh_;  // mesh k (in the cone geometry) -> cone index
+  // mesh k: colour, height, the base centre and the unit axis (base -> top)
+  struct MeshInfo {
+    ConeColor color;
+    double height;
+    double ox, oy, oz;
+    double ax, ay, az;
+  };
+  std::vector<MeshInfo> mesh_info_;
 };
 
 struct LidarPoint {
   float x, y, z;        // m, sensor frame at the point's own time (x forward, y left, z up)
-  float intensity;      // -, [0, 1]; for now 0.5 on cones, 0.1 on the ground
+  float intensity;      // -, [0, 1]; the material model (see the top)
   std::uint16_t ring;   // channel, 0 = lowest elevation
   std::int64_t t;       // ns, the time of the point's column
   std::int32_t cone;    // ground truth: cone index hit, -1 ground

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <stdexcept>
@@ -21,6 +23,7 @@ LidarParams noiseless() {
   LidarParams p;
   p.range_noise = 0.0;
   p.dropout = 0.0;
+  p.intensity_noise = 0.0;
   return p;
 }
 
@@ -87,7 +90,9 @@ TEST_P(LidarSingleCone, HitsLieOnTheConeAndCountIsNearExpected) {
     }
     ASSERT_EQ(q.cone, 0);
     ++on_cone;
-    EXPECT_FLOAT_EQ(q.intensity, 0.5f);
+    // blue (0.25) or white (0.9), cos(incidence) <= 1, full fall-off at <= 5 m
+    EXPECT_GT(q.intensity, 0.0f);
+    EXPECT_LE(q.intensity, 0.9f * (d <= 5.0 ? 1.0f : 25.0f / float(d * d)) + 1e-5f);
     // on the profile: radius at height z
     ASSERT_GE(w.z, -1e-3);
     ASSERT_LE(w.z, h + 1e-3);
@@ -138,10 +143,14 @@ TEST(LidarTest, GroundHitsLieOnTheGroundAndAreInRange) {
   EXPECT_EQ(pts.size(), 16u * 1024u);
   for (const LidarPoint& q : pts) {
     EXPECT_EQ(q.cone, -1);
-    EXPECT_FLOAT_EQ(q.intensity, 0.1f);
     EXPECT_LT(q.ring, 16);
     EXPECT_NEAR(to_world(q, base, p).z, 0.0, 1e-4);
     const double r = range_of(q);
+    // asphalt 0.15 * cos(incidence) (= sin of the depression angle) * fall-off,
+    // from independent numbers
+    const double sin_dep = -q.z / r;
+    const double expect_i = 0.15 * sin_dep * std::min(1.0, (5.0 / r) * (5.0 / r));
+    EXPECT_NEAR(q.intensity, expect_i, 1e-4);
     EXPECT_GE(r, p.range_min);
     EXPECT_LE(r, p.range_max);
   }
@@ -301,6 +310,177 @@ TEST(LidarTest, NonFiniteConeIsSkippedAndIndicesKept) {
   EXPECT_GT(on_big, 0);
 }
 
+// (world height, noise-free intensity) of the points on a cone d ahead
+std::vector<std::pair<double, double>> cone_profile(ConeColor color, double d, int cone_index = 0) {
+  const LidarParams p = noiseless();
+  LidarWorld world({Cone{{p.mount_x + d, 0.0}, color}});
+  std::vector<std::pair<double, double>> zi;
+  for (const LidarPoint& q : Lidar(p, 11).scan(world, at_rest(), 0)) {
+    if (q.cone != cone_index) continue;
+    zi.push_back({to_world(q, Pose2{}, p).z, q.intensity});
+  }
+  return zi;
+}
+
+// the least-squares fit I(z) = a z^2 + b z + c to (z, I) pairs: returns a
+double quadratic_a(const std::vector<std::pair<double, double>>& zi) {
+  // normal equations for [z^2 z 1], solved by Cramer's rule
+  double s[5] = {0, 0, 0, 0, 0}, t[3] = {0, 0, 0};
+  for (const auto& [z, i] : zi) {
+    double zk = 1.0;
+    for (int k = 0; k < 5; ++k) {
+      s[k] += zk;
+      if (k < 3) t[k] += zk * i;
+      zk *= z;
+    }
+  }
+  // M = [[s4 s3 s2] [s3 s2 s1] [s2 s1 s0]], rhs [t2 t1 t0]
+  const auto det3 = [](double a, double b, double c, double d, double e, double f, double g,
+                       double h, double i) {
+    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
+  };
+  const double det = det3(s[4], s[3], s[2], s[3], s[2], s[1], s[2], s[1], s[0]);
+  return det3(t[2], s[3], s[2], t[1], s[2], s[1], t[0], s[1], s[0]) / det;
+}
+
+TEST(LidarIntensity, BlueConePeaksAndYellowConeDipsInTheMiddle) {
+  const auto blue = cone_profile(ConeColor::Blue, 4.0);
+  const auto yellow = cone_profile(ConeColor::Yellow, 4.0);
+  ASSERT_GE(blue.size(), 10u);
+  ASSERT_GE(yellow.size(), 10u);
+  const double a_blue = quadratic_a(blue), a_yellow = quadratic_a(yellow);
+  std::printf("cone at 4 m: blue %zu points a = %.3f, yellow %zu points a = %.3f\n",
+              blue.size(), a_blue, yellow.size(), a_yellow);
+  EXPECT_LT(a_blue, 0.0);
+  EXPECT_GT(a_yellow, 0.0);
+  // the middle stripe (130 .. 195 mm of 325 mm) is white on blue, black on
+  // yellow: compare the brightest point of each band (points at the silhouette
+  // are dim whatever their material: grazing incidence)
+  const auto band_max = [](const std::vector<std::pair<double, double>>& zi, bool middle) {
+    double m = 0.0;
+    for (const auto& [z, i] : zi) {
+      const bool in_mid = z > 0.135 && z < 0.19, outside = z < 0.125 || z > 0.2;
+      if (middle ? in_mid : outside) m = std::max(m, i);
+    }
+    return m;
+  };
+  EXPECT_GT(band_max(blue, true), 0.8);      // white 0.9
+  EXPECT_LT(band_max(blue, false), 0.26);    // blue 0.25
+  EXPECT_LT(band_max(yellow, true), 0.06);   // black 0.05
+  EXPECT_GT(band_max(yellow, false), 0.5);   // yellow 0.6
+}
+
+TEST(LidarIntensity, MaterialsOfTheStripes) {
+  EXPECT_EQ(cone_material(ConeColor::Blue, 0.2), LidarMaterial::Blue);
+  EXPECT_EQ(cone_material(ConeColor::Blue, 0.5), LidarMaterial::White);
+  EXPECT_EQ(cone_material(ConeColor::Yellow, 0.5), LidarMaterial::Black);
+  EXPECT_EQ(cone_material(ConeColor::Yellow, 0.9), LidarMaterial::Yellow);
+  EXPECT_EQ(cone_material(ConeColor::SmallOrange, 0.5), LidarMaterial::White);
+  EXPECT_EQ(cone_material(ConeColor::SmallOrange, 0.1), LidarMaterial::Orange);
+  EXPECT_EQ(cone_material(ConeColor::BigOrange, 0.35), LidarMaterial::White);
+  EXPECT_EQ(cone_material(ConeColor::BigOrange, 0.5), LidarMaterial::Orange);
+  EXPECT_EQ(cone_material(ConeColor::BigOrange, 0.65), LidarMaterial::White);
+  EXPECT_EQ(cone_material(ConeColor::Unknown, 0.5), LidarMaterial::Grey);
+}
+
+TEST(LidarIntensity, FallsWithRangeAndIncidence) {
+  // ground only: with the fall-off switched off (reference range far beyond
+  // the range limit) the intensity is rho cos(incidence); the default divides
+  // it by (r / 5 m)^2 past 5 m
+  LidarParams flat = noiseless();
+  flat.intensity_range_ref = 1e4;
+  const LidarParams def = noiseless();
+  LidarWorld world({});
+  std::map<std::pair<std::int64_t, int>, double> no_falloff;
+  for (const LidarPoint& q : Lidar(flat, 12).scan(world, at_rest(), 0)) {
+    no_falloff[{q.t, q.ring}] = q.intensity;
+  }
+  // per ring (one range, one incidence) at column 512 (straight ahead)
+  std::map<int, std::pair<double, double>> ring_ri;  // ring -> (range, intensity)
+  int checked = 0;
+  for (const LidarPoint& q : Lidar(def, 12).scan(world, at_rest(), 0)) {
+    const double r = range_of(q);
+    const double ratio = q.intensity / no_falloff.at({q.t, q.ring});
+    EXPECT_NEAR(ratio, std::min(1.0, 25.0 / (r * r)), 1e-4) << r;
+    ++checked;
+    if (std::abs(q.y) < 1e-3 && q.x > 0.0) ring_ri[q.ring] = {r, q.intensity};
+  }
+  EXPECT_GT(checked, 1000);
+  // nearer ground (steeper incidence, shorter range) is brighter: rings ascend
+  // in elevation, so range grows and intensity falls with the ring
+  ASSERT_EQ(ring_ri.size(), 16u);
+  for (auto it = std::next(ring_ri.begin()); it != ring_ri.end(); ++it) {
+    const auto prev = std::prev(it);
+    EXPECT_GT(it->second.first, prev->second.first);
+    EXPECT_LT(it->second.second, prev->second.second);
+  }
+  std::printf("ground straight ahead: %.2f m -> I %.4f, %.2f m -> I %.5f\n",
+              ring_ri.begin()->second.first, ring_ri.begin()->second.second,
+              ring_ri.rbegin()->second.first, ring_ri.rbegin()->second.second);
+}
+
+TEST(LidarIntensity, NoiseHasTheConfiguredStd) {
+  LidarParams exact = noiseless();
+  exact.reflect_ground = 1.0;  // bright ground: far from the clamp at 0
+  LidarParams noisy = exact;
+  noisy.intensity_noise = 0.005;
+  LidarWorld world({});
+  std::map<std::pair<std::int64_t, int>, double> truth;
+  for (const LidarPoint& q : Lidar(exact, 13).scan(world, at_rest(), 0)) {
+    truth[{q.t, q.ring}] = q.intensity;
+  }
+  Lidar b(noisy, 13);
+  double sum = 0.0, sum2 = 0.0;
+  int n = 0;
+  for (int rep = 0; rep < 4; ++rep) {
+    for (const LidarPoint& q : b.scan(world, at_rest(), 0)) {
+      const double t = truth.at({q.t, q.ring});
+      if (t < 0.04) continue;  // 8 std from 0: the clamp never acts
+      const double e = q.intensity - t;
+      sum += e;
+      sum2 += e * e;
+      ++n;
+    }
+  }
+  const double mean = sum / n, std = std::sqrt(sum2 / n - mean * mean);
+  std::printf("intensity noise over %d points: mean %.6f, std %.6f\n", n, mean, std);
+  EXPECT_GT(n, 10000);
+  EXPECT_NEAR(std, 0.005, 0.05 * 0.005);
+  EXPECT_NEAR(mean, 0.0, 0.0003);
+}
+
+TEST(LidarKnocked, KnockedConeLiesOnItsSide) {
+  const LidarParams p = noiseless();
+  const double cx = p.mount_x + 4.0;
+  // cone 0 knocked, cone 1 (far to the side) standing
+  LidarWorld world({Cone{{cx, 0.0}, ConeColor::Blue}, Cone{{cx, 3.0}, ConeColor::Blue}},
+                   {true, false});
+  int lying = 0, standing = 0;
+  double top_lying = 0.0, top_standing = 0.0;
+  for (const LidarPoint& q : Lidar(p, 14).scan(world, at_rest(), 0)) {
+    if (q.cone < 0) continue;
+    const P3 w = to_world(q, Pose2{}, p);
+    if (q.cone == 0) {
+      ++lying;
+      top_lying = std::max(top_lying, w.z);
+      EXPECT_LE(w.z, 0.228 + 1e-3);                 // its base width
+      EXPECT_LE(std::abs(w.x - cx), 0.1625 + 1e-3);  // half its length along x
+      EXPECT_LE(std::abs(w.y), 0.114 + 1e-3);
+    } else {
+      ++standing;
+      top_standing = std::max(top_standing, w.z);
+    }
+  }
+  std::printf("knocked cone: %d points up to %.3f m; standing: %d points up to %.3f m\n",
+              lying, top_lying, standing, top_standing);
+  EXPECT_GT(lying, 5);
+  EXPECT_GT(standing, 5);
+  EXPECT_LT(top_lying, 0.23);
+  EXPECT_GT(top_standing, 0.25);  // the standing cone is seen above the lying height
+  EXPECT_THROW(LidarWorld({Cone{{cx, 0.0}, ConeColor::Blue}}, {true, false}),
+               std::invalid_argument);
+}
+
 TEST(LidarTest, InvalidParamsAreRejected) {
   LidarParams p;
   EXPECT_EQ(validate(p), "");
@@ -318,6 +498,15 @@ TEST(LidarTest, InvalidParamsAreRejected) {
   p = LidarParams{};
   p.rate = std::numeric_limits<double>::quiet_NaN();
   EXPECT_NE(validate(p).find("rate"), std::string::npos);
+  p = LidarParams{};
+  p.reflect_blue = 1.5;
+  EXPECT_NE(validate(p).find("reflect_"), std::string::npos);
+  p = LidarParams{};
+  p.intensity_noise = -0.1;
+  EXPECT_NE(validate(p).find("intensity_noise"), std::string::npos);
+  p = LidarParams{};
+  p.intensity_range_ref = 0.0;
+  EXPECT_NE(validate(p).find("intensity_range_ref"), std::string::npos);
 }
 
 }  // namespace
