@@ -112,11 +112,44 @@ std::string validate(const LidarParams& p) {
   return os.str();
 }
 
+std::string validate(const GroundParams& g) {
+  std::ostringstream os;
+  if (!finite(g.slope_x) || !finite(g.slope_y)) {
+    os << "slope_x and slope_y must be finite";
+  } else if (!finite(g.bump_height)) {
+    os << "bump_height must be finite (got " << g.bump_height << ")";
+  } else if (!finite(g.bump_wavelength) || !(g.bump_wavelength > 0.0)) {
+    os << "bump_wavelength must be finite and > 0 (got " << g.bump_wavelength << ")";
+  } else if (!finite(g.cell) || !(g.cell > 0.0)) {
+    os << "cell must be finite and > 0 (got " << g.cell << ")";
+  }
+  return os.str();
+}
+
+bool flat(const GroundParams& g) {
+  return g.slope_x == 0.0 && g.slope_y == 0.0 && g.bump_height == 0.0;
+}
+
+double ground_height(const GroundParams& g, double x, double y) {
+  double z = g.slope_x * x + g.slope_y * y;
+  if (g.bump_height != 0.0) {
+    const double k = 2.0 * kPi / g.bump_wavelength;
+    z += g.bump_height * std::sin(k * x) * std::sin(k * y);
+  }
+  return z;
+}
+
 // ---------------------------------------------------------------- LidarWorld
 
-LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked) {
+LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked,
+                       const GroundParams& ground)
+    : ground_(ground) {
   if (!knocked.empty() && knocked.size() != cones.size()) {
     throw std::invalid_argument("LidarWorld: knocked must be empty or of the size of cones");
+  }
+  {
+    const std::string err = validate(ground_);
+    if (!err.empty()) throw std::invalid_argument("LidarWorld: GroundParams: " + err);
   }
   // one worker thread: many simulations may run side by side in one process
   device_ = rtcNewDevice("threads=1");
@@ -148,8 +181,8 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
     }
     cone_count_ = cones.size();
 
-    // ground: two triangles at z = 0
-    {
+    // ground: two triangles at z = 0 when flat, else a height-field grid
+    if (flat(ground_)) {
       RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
       check(device_, "rtcNewGeometry(ground)");
       auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -164,6 +197,58 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
       std::copy(quad, quad + 12, v);
       const unsigned tris[6] = {0, 1, 2, 0, 2, 3};
       std::copy(tris, tris + 6, idx);
+      rtcCommitGeometry(g);
+      ground_geom_ = rtcAttachGeometry(scene_, g);
+      rtcReleaseGeometry(g);
+      check(device_, "ground geometry");
+      ground_triangles_ = 2;
+    } else {
+      const double m = kGridMargin;
+      const double x0 = lo_x - m, y0 = lo_y - m;
+      const double wx = hi_x - lo_x + 2.0 * m, wy = hi_y - lo_y + 2.0 * m;
+      // the cell: at least ground.cell, and large enough for kMaxGridCells
+      double cell = std::max(ground_.cell, std::sqrt(wx * wy / kMaxGridCells));
+      auto nx = static_cast<std::size_t>(std::ceil(wx / cell));
+      auto ny = static_cast<std::size_t>(std::ceil(wy / cell));
+      while (static_cast<double>(nx) * static_cast<double>(ny) > kMaxGridCells) {
+        cell *= 1.01;
+        nx = static_cast<std::size_t>(std::ceil(wx / cell));
+        ny = static_cast<std::size_t>(std::ceil(wy / cell));
+      }
+      nx = std::max<std::size_t>(nx, 1);
+      ny = std::max<std::size_t>(ny, 1);
+      ground_cell_ = cell;
+      ground_triangles_ = 2 * nx * ny;
+      RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+      check(device_, "rtcNewGeometry(ground)");
+      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+          (nx + 1) * (ny + 1)));
+      auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+          ground_triangles_));
+      check(device_, "rtcSetNewGeometryBuffer(ground)");
+      for (std::size_t j = 0; j <= ny; ++j) {
+        const double y = y0 + cell * static_cast<double>(j);
+        for (std::size_t i = 0; i <= nx; ++i) {
+          const double x = x0 + cell * static_cast<double>(i);
+          float* p = v + 3 * (j * (nx + 1) + i);
+          p[0] = static_cast<float>(x);
+          p[1] = static_cast<float>(y);
+          p[2] = static_cast<float>(ground_height(ground_, x, y));
+        }
+      }
+      for (std::size_t j = 0; j < ny; ++j) {
+        for (std::size_t i = 0; i < nx; ++i) {
+          const auto a = static_cast<unsigned>(j * (nx + 1) + i);
+          const auto b = a + 1;
+          const auto d = static_cast<unsigned>((j + 1) * (nx + 1) + i);
+          const auto c = d + 1;
+          unsigned* q = idx + 6 * (j * nx + i);
+          q[0] = a; q[1] = b; q[2] = c;
+          q[3] = a; q[4] = c; q[5] = d;
+        }
+      }
       rtcCommitGeometry(g);
       ground_geom_ = rtcAttachGeometry(scene_, g);
       rtcReleaseGeometry(g);
@@ -192,8 +277,9 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
         // centre) to the world: standing, a translation; knocked, first a
         // 90 deg rotation about y, (lx, ly, lz) -> (lz, ly, -lx), then the base
         // centre to (px - h/2, py, r0)
+        const double gz = ground_height(ground_, c.position.x, c.position.y);
         const double ox = down ? c.position.x - 0.5 * h : c.position.x;
-        const double oz = down ? r0 : 0.0;
+        const double oz = gz + (down ? r0 : 0.0);
         const auto put = [&](float* out, double lx, double ly, double lz) {
           out[0] = static_cast<float>(ox + (down ? lz : lx));
           out[1] = static_cast<float>(c.position.y + ly);
@@ -322,6 +408,7 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
     if (!finite(pose.x) || !finite(pose.y) || !finite(pose.yaw)) continue;
     const double cy = std::cos(pose.yaw), sy = std::sin(pose.yaw);
     const Vec2 origin = pose.transform({params_.mount_x, params_.mount_y});
+    const double oz = world.ground_z(origin.x, origin.y) + params_.mount_z;
     const auto cu = static_cast<std::size_t>(c);
     const double ca = cos_az_[cu], sa = sin_az_[cu];
     // the column's channels in packets of 16 rays (coherent: one origin, one azimuth)
@@ -342,7 +429,7 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
         const double px = cp * dx + sp * dz, pz = -sp * dx + cp * dz;
         rh.ray.org_x[j] = static_cast<float>(origin.x);
         rh.ray.org_y[j] = static_cast<float>(origin.y);
-        rh.ray.org_z[j] = static_cast<float>(params_.mount_z);
+        rh.ray.org_z[j] = static_cast<float>(oz);
         rh.ray.dir_x[j] = static_cast<float>(cy * px - sy * dy);
         rh.ray.dir_y[j] = static_cast<float>(sy * px + cy * dy);
         rh.ray.dir_z[j] = static_cast<float>(pz);

@@ -1,6 +1,7 @@
 #pragma once
 // a rotating multi-channel LiDAR, ray-cast with Embree 3 against cone meshes of
-// their real size standing on a flat ground plane (z = 0).
+// their real size standing on the ground: a flat plane z = 0 or a height field
+// (GroundParams: a slope plus sinusoidal bumps).
 //
 // Model (LidarParams) + the scene (LidarWorld: the Embree device and scene,
 // built once from the cones) + a small class holding only its random stream
@@ -26,7 +27,13 @@
 //
 // Knocked cones lie on their side (LidarWorld's `knocked`).
 //
-// Not modelled yet: sloped or bumpy ground.
+// Ground (GroundParams): z = ground_height(g, x, y) in the world frame. Flat
+// (the default) it is two triangles at z = 0; otherwise a triangle grid whose
+// vertices lie on ground_height (see LidarWorld). The sensor keeps its mount_z
+// above the ground under the mounting point: the rays start at world z =
+// ground_height(mount point) + mount_z. The car's body is not tilted by the
+// slope (no roll or pitch from the ground): the sensor frame stays level, only
+// mount_pitch tilts it, and the points' z is relative to the optical centre.
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -92,6 +99,24 @@ class LidarError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// the ground's height field, world frame
+struct GroundParams {
+  double slope_x = 0.0, slope_y = 0.0;  // -, dz/dx and dz/dy of the plane
+  double bump_height = 0.0;             // m, amplitude of the bumps
+  double bump_wavelength = 10.0;        // m, > 0
+  double cell = 0.5;                    // m, > 0: the grid's cell (a lower bound, see LidarWorld)
+};
+
+// "" when every field is usable, else the first problem
+std::string validate(const GroundParams& g);
+
+// true when g is the plane z = 0 (no slope, no bumps)
+bool flat(const GroundParams& g);
+
+// z = slope_x x + slope_y y + bump_height sin(2 pi x / L) sin(2 pi y / L),
+// L = bump_wavelength
+double ground_height(const GroundParams& g, double x, double y);
+
 // the real FS cone sizes (ORACLES.md): a cone mesh is a truncated cone of
 // kConeSegments facets standing on its base, vertices on the true circles
 inline constexpr double kSmallConeBaseWidth = 0.228;  // m
@@ -123,30 +148,51 @@ LidarMaterial cone_material(ConeColor color, double height_fraction);
 
 // the reflectivity p assigns to material m
 double reflectivity(const LidarParams& p, LidarMaterial m);
-// the static scene: cones (BigOrange big, every other colour small) and a flat
-// ground quad at z = 0 that extends kGroundMargin past the cones' bounding box.
+// the static scene: cones (BigOrange big, every other colour small) and the
+// ground. Flat ground is one quad at z = 0 that extends kGroundMargin past the
+// cones' bounding box. Any other ground is a grid of right-triangle pairs over
+// the cones' bounding box plus kGridMargin, vertices on ground_height; its cell
+// is ground.cell, enlarged (if need be) so the grid has at most kMaxGridCells
+// cells (2 triangles each). Inside a triangle the grid interpolates linearly:
+// for a right isosceles triangle with legs h (circumradius h / sqrt 2) the
+// vertical error is at most M R^2 / 2 = M h^2 / 4, M the largest |eigenvalue|
+// of ground_height's Hessian = bump_height (2 pi / L)^2 (the plane adds none):
+// 2.5 mm for 0.1 m bumps, L = 10 m, h = 0.5 m. Rays that leave the grid find
+// no ground.
 // Owns the Embree device and scene; non-copyable, non-movable.
 //
-// A standing cone stands on its base centred on its position. A knocked cone
+// A standing cone stands on its base centred on its position, the base (kept
+// horizontal) at ground_height there. A knocked cone
 // (knocked[i] true) lies on its side: its mesh is rotated 90 deg about the
 // world y axis, so its axis is horizontal along the world +x axis (base at
 // -x, top at +x), at the height of its base radius (0.114 m small, 0.1425 m
-// big: the base rim touches the ground, the top end floats a little), the
-// middle of its axis above its position. It reaches up to its base width
+// big) above ground_height at its position (flat ground: the base rim touches
+// the ground, the top end floats a little), the middle of its axis above its
+// position. It reaches up to its base width
 // (0.228 m small, 0.285 m big).
 class LidarWorld {
  public:
-  static constexpr double kGroundMargin = 500.0;  // m
+  static constexpr double kGroundMargin = 500.0;     // m, flat ground
+  static constexpr double kGridMargin = 60.0;        // m, height-field ground
+  static constexpr double kMaxGridCells = 200000.0;  // -, height-field ground
   // throws LidarError on an Embree failure, std::invalid_argument when knocked
-  // is neither empty (no cone knocked) nor of the size of cones. Cones with a
-  // non-finite position are left out (and are never reported as hit).
-  explicit LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked = {});
+  // is neither empty (no cone knocked) nor of the size of cones, or when
+  // validate(ground) fails. Cones with a non-finite position are left out (and
+  // are never reported as hit).
+  explicit LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked = {},
+                      const GroundParams& ground = {});
   ~LidarWorld();
   LidarWorld(const LidarWorld&) = delete;
   LidarWorld& operator=(const LidarWorld&) = delete;
 
   RTCScene scene() const { return scene_; }
   std::size_t cone_count() const { return cone_count_; }
+  const GroundParams& ground() const { return ground_; }
+  // ground_height(ground(), x, y)
+  double ground_z(double x, double y) const { return ground_height(ground_, x, y); }
+  // the grid's cell actually used (0 for flat ground) and its triangle count
+  double ground_cell() const { return ground_cell_; }
+  std::size_t ground_triangles() const { return ground_triangles_; }
   // the cone index hit by (geomID, primID), -1 for the ground, -2 for nothing
   std::int32_t cone_of(unsigned geom_id, unsigned prim_id) const;
   // the material at the hit (geomID, primID) at world point (x, y, z): the
@@ -159,6 +205,9 @@ class LidarWorld {
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   std::size_t cone_count_ = 0;
+  GroundParams ground_;
+  double ground_cell_ = 0.0;
+  std::size_t ground_triangles_ = 0;
   unsigned ground_geom_ = RTC_INVALID_GEOMETRY_ID;
   unsigned cone_geom_ = RTC_INVALID_GEOMETRY_ID;
   std::vector<std::int32_t> cone_of_mesh_;  // mesh k (in the cone geometry) -> cone index
@@ -188,7 +237,8 @@ class Lidar {
 
   // one rotation. Column c is cast at t_c = start + c * period / columns (integer
   // ns) from the base pose base_pose_at(t_c), all channels at once; the rays
-  // start at the mounting point. Returns the hits whose measured range (true
+  // start at the mounting point, mount_z above world.ground_z there. Returns
+  // the hits whose measured range (true
   // range + N(0, range_noise)) lies in [range_min, range_max], less the
   // dropouts, column by column, rings ascending within a column, each in the
   // sensor frame at its column's time. A column whose pose is not finite gives

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <algorithm>
 #include <cstdio>
@@ -507,6 +508,156 @@ TEST(LidarTest, InvalidParamsAreRejected) {
   p = LidarParams{};
   p.intensity_range_ref = 0.0;
   EXPECT_NE(validate(p).find("intensity_range_ref"), std::string::npos);
+}
+
+
+// a point in the world frame over sloped or bumpy ground: the sensor stands
+// mount_z above the ground under its mounting point
+P3 to_world_on(const LidarPoint& q, const Pose2& base, const LidarParams& p,
+               const LidarWorld& world) {
+  P3 w = to_world(q, base, p);
+  const Vec2 o = base.transform({p.mount_x, p.mount_y});
+  w.z += world.ground_z(o.x, o.y);
+  return w;
+}
+
+TEST(LidarGround, HeightFieldFormulaAndValidation) {
+  GroundParams g;
+  EXPECT_TRUE(flat(g));
+  EXPECT_EQ(validate(g), "");
+  EXPECT_DOUBLE_EQ(ground_height(g, 3.0, -7.0), 0.0);
+  g.slope_x = 0.1;
+  g.slope_y = -0.05;
+  EXPECT_FALSE(flat(g));
+  EXPECT_NEAR(ground_height(g, 3.0, 2.0), 0.3 - 0.1, 1e-12);
+  g = GroundParams{};
+  g.bump_height = 0.1;
+  g.bump_wavelength = 8.0;
+  EXPECT_NEAR(ground_height(g, 2.0, 2.0), 0.1, 1e-12);   // sin(pi/2)^2
+  EXPECT_NEAR(ground_height(g, 2.0, -2.0), -0.1, 1e-12);
+  EXPECT_NEAR(ground_height(g, 4.0, 1.0), 0.0, 1e-12);
+  GroundParams bad;
+  bad.cell = 0.0;
+  EXPECT_NE(validate(bad).find("cell"), std::string::npos);
+  EXPECT_THROW(LidarWorld({}, {}, bad), std::invalid_argument);
+  bad = GroundParams{};
+  bad.bump_wavelength = -1.0;
+  EXPECT_NE(validate(bad).find("bump_wavelength"), std::string::npos);
+  bad = GroundParams{};
+  bad.slope_x = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(validate(bad).find("slope"), std::string::npos);
+  // flat: the two-triangle fast path
+  LidarWorld flat_world({Cone{{5.0, 0.0}, ConeColor::Blue}});
+  EXPECT_EQ(flat_world.ground_triangles(), 2u);
+  EXPECT_EQ(flat_world.ground_cell(), 0.0);
+}
+
+TEST(LidarGround, GridIsBoundedInSize) {
+  GroundParams g;
+  g.slope_x = 0.05;
+  // a 1 km x 1 km cone field: the cell grows so the grid stays bounded
+  LidarWorld world({Cone{{0.0, 0.0}, ConeColor::Blue}, Cone{{1000.0, 1000.0}, ConeColor::Blue}},
+                   {}, g);
+  EXPECT_LE(world.ground_triangles(), 2u * 200000u);
+  EXPECT_GT(world.ground_cell(), 0.5);
+  LidarWorld small({Cone{{0.0, 0.0}, ConeColor::Blue}, Cone{{30.0, 20.0}, ConeColor::Blue}}, {},
+                   g);
+  EXPECT_DOUBLE_EQ(small.ground_cell(), 0.5);
+  // (30 + 120) x (20 + 120) m at 0.5 m: 300 x 280 cells, 2 triangles each
+  EXPECT_EQ(small.ground_triangles(), 2u * 300u * 280u);
+}
+
+TEST(LidarGround, SlopedGroundPointsLieOnThePlane) {
+  const LidarParams p = noiseless();
+  GroundParams g;
+  g.slope_x = 0.1;
+  const std::vector<Cone> cones = {Cone{{-20.0, -15.0}, ConeColor::Blue},
+                                   Cone{{40.0, 15.0}, ConeColor::Yellow}};
+  const auto t0 = std::chrono::steady_clock::now();
+  LidarWorld world(cones, {}, g);
+  const auto t1 = std::chrono::steady_clock::now();
+  Lidar lidar(p, 21);
+  const Pose2 base{1.0, 2.0, 0.4};
+  const std::vector<LidarPoint> pts = lidar.scan(world, at_rest(base), 0);
+  const auto t2 = std::chrono::steady_clock::now();
+  std::printf("sloped world: %zu ground triangles, build %.1f ms, one scan %.1f ms (%zu points)\n",
+              world.ground_triangles(),
+              std::chrono::duration<double, std::milli>(t1 - t0).count(),
+              std::chrono::duration<double, std::milli>(t2 - t1).count(), pts.size());
+  int ground = 0;
+  double worst = 0.0;
+  for (const LidarPoint& q : pts) {
+    if (q.cone != -1) continue;
+    ++ground;
+    const P3 w = to_world_on(q, base, p, world);
+    worst = std::max(worst, std::abs(w.z - 0.1 * w.x));
+  }
+  std::printf("sloped ground: %d points, worst |z - 0.1 x| %.4f m\n", ground, worst);
+  EXPECT_GT(ground, 16 * 1024 / 2);
+  EXPECT_LT(worst, 0.01);
+}
+
+TEST(LidarGround, ConesStandOnTheSlopedGround) {
+  // a dense fan of channels so the lowest ring on the cone lies near its base
+  LidarParams p = noiseless();
+  p.channels = 281;
+  p.elevation_min = -2.0 * kPi / 180.0;
+  p.elevation_max = 12.0 * kPi / 180.0;  // 0.05 deg: 9 mm at 10 m
+  GroundParams g;
+  g.slope_x = 0.1;
+  const double cx = 12.0;
+  // cone 0 standing ahead, uphill; cone 1 knocked, beside it
+  LidarWorld world({Cone{{cx, 0.0}, ConeColor::Blue}, Cone{{cx, 2.0}, ConeColor::Yellow}},
+                   {false, true}, g);
+  const double gz = ground_height(g, cx, 0.0);  // 1.2 m
+  double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
+  int n[2] = {0, 0};
+  for (const LidarPoint& q : Lidar(p, 22).scan(world, at_rest(), 0)) {
+    if (q.cone < 0) continue;
+    const P3 w = to_world_on(q, Pose2{}, p, world);
+    const auto k = static_cast<std::size_t>(q.cone);
+    ++n[k];
+    lo[k] = std::min(lo[k], w.z);
+    hi[k] = std::max(hi[k], w.z);
+  }
+  std::printf("on the slope (ground %.3f m): standing %d points %.3f .. %.3f m, knocked %d "
+              "points %.3f .. %.3f m\n",
+              gz, n[0], lo[0], hi[0], n[1], lo[1], hi[1]);
+  ASSERT_GT(n[0], 10);
+  ASSERT_GT(n[1], 10);
+  EXPECT_NEAR(lo[0], gz, 0.02);
+  EXPECT_NEAR(hi[0], gz + 0.325, 0.02);
+  EXPECT_NEAR(lo[1], gz, 0.02);
+  EXPECT_LE(hi[1], gz + 0.228 + 1e-3);
+  // the same cones on flat ground stand 1.2 m lower: the slope really lifts them
+  EXPECT_GT(lo[0], 1.0);
+}
+
+TEST(LidarGround, BumpyGroundPointsLieOnTheHeightField) {
+  const LidarParams p = noiseless();
+  GroundParams g;
+  g.bump_height = 0.1;
+  g.bump_wavelength = 10.0;
+  // the grid's error bound: bump_height (2 pi / L)^2 cell^2 / 4 = 2.5 mm
+  const double bound = 0.1 * std::pow(2.0 * kPi / 10.0, 2) * 0.25 / 4.0;
+  EXPECT_LT(bound, 0.003);
+  LidarWorld world({Cone{{-20.0, -15.0}, ConeColor::Blue}, Cone{{40.0, 15.0}, ConeColor::Yellow}},
+                   {}, g);
+  EXPECT_DOUBLE_EQ(world.ground_cell(), 0.5);
+  const Pose2 base{3.0, 1.0, -0.3};
+  int ground = 0;
+  double worst = 0.0;
+  for (const LidarPoint& q : Lidar(p, 23).scan(world, at_rest(base), 0)) {
+    if (q.cone != -1) continue;
+    ++ground;
+    const P3 w = to_world_on(q, base, p, world);
+    worst = std::max(worst, std::abs(w.z - ground_height(g, w.x, w.y)));
+  }
+  std::printf("bumpy ground: %d points, worst |z - ground_height| %.4f m (bound %.4f m)\n",
+              ground, worst, bound);
+  EXPECT_GT(ground, 1000);
+  EXPECT_LT(worst, 0.02);
+  EXPECT_LT(worst, bound + 1e-3);  // float rounding on top of the interpolation
 }
 
 }  // namespace
