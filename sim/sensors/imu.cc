@@ -4,22 +4,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sim/sensors/param_check.h"
+
 namespace paddock::sensors {
-
-namespace {
-
-constexpr double kInf = 1e300;  // "no upper bound" that still prints as a number
-
-// "" when lo <= value <= hi and finite, else "<name> must be a finite number in [lo, hi] unit (got value)"
-std::string check(const char* name, double value, double lo, double hi, const char* unit) {
-  if (std::isfinite(value) && value >= lo && value <= hi) return {};
-  std::ostringstream s;
-  s << name << " must be a finite number in [" << lo << ", " << hi << "]" << (unit[0] ? " " : "") << unit
-    << " (got " << value << ")";
-  return s.str();
-}
-
-}  // namespace
 
 std::string validate(const ImuParams& p) {
   // rate: positive; 100 kHz bounds the sample count of a run
@@ -36,17 +23,17 @@ std::string validate(const ImuParams& p) {
     const char* unit;
   };
   const Field fields[] = {
-      {"accel_noise", p.accel_noise, 0.0, kInf, "m/s^2"},
-      {"gyro_noise", p.gyro_noise, 0.0, kInf, "rad/s"},
-      {"accel_bias_walk", p.accel_bias_walk, 0.0, kInf, "m/s^2/sqrt(s)"},
-      {"gyro_bias_walk", p.gyro_bias_walk, 0.0, kInf, "rad/s/sqrt(s)"},
-      {"accel_bias_initial_std", p.accel_bias_initial_std, 0.0, kInf, "m/s^2"},
-      {"gyro_bias_initial_std", p.gyro_bias_initial_std, 0.0, kInf, "rad/s"},
-      {"mount_x", p.mount_x, -kInf, kInf, "m"},
-      {"mount_y", p.mount_y, -kInf, kInf, "m"},
+      {"accel_noise", p.accel_noise, 0.0, kNoUpperBound, "m/s^2"},
+      {"gyro_noise", p.gyro_noise, 0.0, kNoUpperBound, "rad/s"},
+      {"accel_bias_walk", p.accel_bias_walk, 0.0, kNoUpperBound, "m/s^2/sqrt(s)"},
+      {"gyro_bias_walk", p.gyro_bias_walk, 0.0, kNoUpperBound, "rad/s/sqrt(s)"},
+      {"accel_bias_initial_std", p.accel_bias_initial_std, 0.0, kNoUpperBound, "m/s^2"},
+      {"gyro_bias_initial_std", p.gyro_bias_initial_std, 0.0, kNoUpperBound, "rad/s"},
+      {"mount_x", p.mount_x, -kNoUpperBound, kNoUpperBound, "m"},
+      {"mount_y", p.mount_y, -kNoUpperBound, kNoUpperBound, "m"},
   };
   for (const Field& f : fields) {
-    std::string msg = check(f.name, f.value, f.lo, f.hi, f.unit);
+    std::string msg = check_range(f.name, f.value, f.lo, f.hi, f.unit);
     if (!msg.empty()) return msg;
   }
   return {};

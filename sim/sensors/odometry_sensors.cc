@@ -7,20 +7,11 @@
 
 #include "autonomy/common/geometry.h"
 
+#include "sim/sensors/param_check.h"
+
 namespace paddock::sensors {
 
 namespace {
-
-constexpr double kInf = 1e300;  // "no upper bound" that still prints as a number
-
-// "" when lo <= value <= hi and finite, else "<name> must be a finite number in [lo, hi] unit (got value)"
-std::string check(const char* name, double value, double lo, double hi, const char* unit) {
-  if (std::isfinite(value) && value >= lo && value <= hi) return {};
-  std::ostringstream s;
-  s << name << " must be a finite number in [" << lo << ", " << hi << "]" << (unit[0] ? " " : "") << unit
-    << " (got " << value << ")";
-  return s.str();
-}
 
 // rate: positive; 100 kHz bounds the sample count of a run
 std::string check_rate(double rate) {
@@ -37,17 +28,17 @@ double quantise(double v, double step) { return step > 0.0 ? step * std::round(v
 
 std::string validate(const WheelSpeedParams& p) {
   std::string msg = check_rate(p.rate);
-  if (msg.empty()) msg = check("noise", p.noise, 0.0, kInf, "rad/s");
-  if (msg.empty()) msg = check("resolution", p.resolution, 0.0, kInf, "rad/s");
+  if (msg.empty()) msg = check_range("noise", p.noise, 0.0, kNoUpperBound, "rad/s");
+  if (msg.empty()) msg = check_range("resolution", p.resolution, 0.0, kNoUpperBound, "rad/s");
   return msg;
 }
 
 std::string validate(const SteeringSensorParams& p) {
   std::string msg = check_rate(p.rate);
-  if (msg.empty()) msg = check("noise", p.noise, 0.0, kInf, "rad");
-  if (msg.empty()) msg = check("resolution", p.resolution, 0.0, kInf, "rad");
+  if (msg.empty()) msg = check_range("noise", p.noise, 0.0, kNoUpperBound, "rad");
+  if (msg.empty()) msg = check_range("resolution", p.resolution, 0.0, kNoUpperBound, "rad");
   // a zero more than a quarter turn of road wheel off is not a calibration
-  if (msg.empty()) msg = check("offset", p.offset, -0.5 * kPi, 0.5 * kPi, "rad");
+  if (msg.empty()) msg = check_range("offset", p.offset, -0.5 * kPi, 0.5 * kPi, "rad");
   return msg;
 }
 

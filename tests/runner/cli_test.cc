@@ -2,15 +2,13 @@
 // output files, and determinism of a whole run
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 
 #include "sim/runner/files.h"
+#include "tests/runner/run_paddock.h"
 
 namespace {
 
@@ -19,23 +17,8 @@ using ::testing::HasSubstr;
 
 const std::string kRoot = PADDOCK_SOURCE_DIR;
 
-struct Outcome {
-  int code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-Outcome paddock(const std::string& args) {
-  const std::string cmd = std::string(PADDOCK_BINARY) + " " + args + " 2>&1";
-  Outcome o;
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return o;
-  std::array<char, 4096> buf{};
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) o.output.append(buf.data(), n);
-  const int status = pclose(p);
-  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return o;
-}
+using paddock::testing::Outcome;
+Outcome paddock(const std::string& args) { return paddock::testing::run_paddock(args); }
 
 std::string scratch(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / "paddock_cli_test";

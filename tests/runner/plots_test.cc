@@ -4,14 +4,12 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 
 #include "render/figures.h"
 #include "sim/runner/files.h"
+#include "tests/runner/run_paddock.h"
 
 namespace paddock::runner {
 namespace {
@@ -21,22 +19,8 @@ using ::testing::HasSubstr;
 
 const std::string kRoot = PADDOCK_SOURCE_DIR;
 
-struct Outcome {
-  int code = -1;
-  std::string output;
-};
-
-Outcome paddock(const std::string& args) {
-  Outcome o;
-  FILE* p = popen((std::string(PADDOCK_BINARY) + " " + args + " 2>&1").c_str(), "r");
-  if (!p) return o;
-  std::array<char, 4096> buf{};
-  size_t n;
-  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) o.output.append(buf.data(), n);
-  const int status = pclose(p);
-  o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return o;
-}
+using paddock::testing::Outcome;
+Outcome paddock(const std::string& args) { return paddock::testing::run_paddock(args); }
 
 std::string scratch(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / "paddock_plots_test" / name;
