@@ -2,6 +2,7 @@
 // what crosses the HAL: timestamped sensor messages in, actuator commands out.
 // The sim back end and the hardware back end produce exactly these.
 #include <array>
+#include <cstdint>
 #include <variant>
 #include <vector>
 
@@ -66,7 +67,45 @@ struct SteeringAngle {
   double angle = 0.0;  // rad, > 0 left
 };
 
-using SensorMessage = std::variant<StateEstimate, ResSignal, ConeDetections, Imu, WheelSpeeds, SteeringAngle>;
+// one return of a rotating LiDAR, in the sensor frame `lidar` (x forward, y
+// left, z up; origin at the optical centre) as it stood at the point's own time
+struct LidarPoint {
+  float x = 0.0f, y = 0.0f, z = 0.0f;  // m
+  float intensity = 0.0f;              // -, [0, 1]
+  std::uint16_t ring = 0;              // channel, 0 = lowest elevation
+  std::int64_t t = 0;                  // ns, when the point's column was fired
+};
+
+// one rotation of the LiDAR: raw points, column by column, each with its own
+// time (a moving car's scan is distorted: nothing is corrected here)
+struct LidarScan {
+  TimeNs stamp = 0;  // the first column's time
+  TimeNs end = 0;    // the last column's time
+  std::vector<LidarPoint> points;
+};
+
+// simulation's annotation of one cone seen by the camera (a labelled data
+// set's box label); a hardware camera gives none
+struct CameraInstance {
+  std::int32_t id = -1;                  // the value of its pixels in CameraFrame::labels
+  ConeColor color = ConeColor::Unknown;  // its class
+  double range = 0.0;                    // m, from the camera's optical centre to the cone
+  double visible_fraction = 1.0;         // -, visible pixels / pixels it would cover unoccluded
+};
+
+// one camera image (global shutter), triggered by the LiDAR once per rotation
+struct CameraFrame {
+  TimeNs stamp = 0;  // exposure time
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgb;  // row-major, 3 bytes a pixel, row 0 at the top
+  // simulation only (empty from hardware): per pixel the id of the cone
+  // instance it shows, -1 for none; and the instances
+  std::vector<std::int32_t> labels;
+  std::vector<CameraInstance> instances;
+};
+
+using SensorMessage = std::variant<StateEstimate, ResSignal, ConeDetections, Imu, WheelSpeeds, SteeringAngle,
+                                   LidarScan, CameraFrame>;
 
 // the stack's command to the car's low-level controllers
 struct ActuatorCommand {

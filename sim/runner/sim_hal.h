@@ -3,6 +3,7 @@
 // stack drains them and leaves its command here for the actuators.
 #include <deque>
 #include <optional>
+#include <utility>
 
 #include "autonomy/hal/hal.h"
 
@@ -10,10 +11,10 @@ namespace paddock::runner {
 
 class SimHal final : public hal::Hal {
  public:
-  void post(const hal::SensorMessage& m) { inbox_.push_back(m); }
+  void post(hal::SensorMessage m) { inbox_.push_back(std::move(m)); }
   std::optional<hal::SensorMessage> receive() override {
     if (inbox_.empty()) return std::nullopt;
-    hal::SensorMessage m = inbox_.front();
+    hal::SensorMessage m = std::move(inbox_.front());
     inbox_.pop_front();
     return m;
   }

@@ -1,0 +1,54 @@
+#pragma once
+// the values that pass between the perception pipeline's stages: the LiDAR
+// pipeline's cone candidates, the camera detector's boxes, and the sensors'
+// calibration the stack is told (the same numbers the simulator's sensors use,
+// or the car's calibration files).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "autonomy/common/cone.h"
+#include "autonomy/common/geometry.h"
+
+namespace paddock::perception {
+
+// where the LiDAR sits and how its beams are laid out
+struct LidarCalibration {
+  // mounting in the base frame (the sensor frame's yaw is the base's; pitch
+  // about its y axis, > 0 tilts it nose down)
+  double mount_x = 2.2, mount_y = 0.0, mount_z = 0.15;  // m
+  double mount_pitch = 0.0;                             // rad
+  // channels evenly spaced in elevation from elevation_min to elevation_max
+  int channels = 32;
+  double elevation_min = -16.0 * kPi / 180.0;  // rad
+  double elevation_max = 15.0 * kPi / 180.0;   // rad
+  int columns = 1024;                          // per rotation
+};
+
+// the pinhole camera: intrinsics K and extrinsics [R|T] = T_camera_base (the
+// base frame into the camera's optical frame: z forward, x right, y down)
+struct CameraCalibration {
+  int width = 0, height = 0;  // px
+  double fx = 0.0, fy = 0.0;  // px
+  double cx = 0.0, cy = 0.0;  // px
+  Eigen::Isometry3d T_camera_base = Eigen::Isometry3d::Identity();
+};
+
+// a cone found by the LiDAR pipeline: its cluster's centre in the base frame
+// at the scan's reference time (the rotation's end, motion-corrected)
+struct ConeCandidate {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // m, base frame
+  ConeColor color = ConeColor::Unknown;              // from the intensity profile (Unknown: undecided)
+  int points = 0;                                    // in the (reconstructed) cluster
+};
+
+// one box of the camera detector, in pixels (x right, y down, row 0 at the top)
+struct BoundingBox {
+  double x_min = 0.0, y_min = 0.0, x_max = 0.0, y_max = 0.0;  // px
+  ConeColor color = ConeColor::Unknown;                       // the detector's class
+  double confidence = 1.0;                                    // -, [0, 1]
+};
+
+}  // namespace paddock::perception
