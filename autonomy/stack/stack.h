@@ -19,7 +19,10 @@
 namespace paddock::stack {
 
 // where each layer's input comes from (the scenario's [autonomy] section)
-enum class PerceptionMode { GroundTruth };
+// perception: ground_truth = the simulator's object-level cone sensor posts
+// cone detections; lidar = the LiDAR pipeline on raw scans (intensity colour);
+// lidar_camera = the LiDAR pipeline fused with the camera detector
+enum class PerceptionMode { GroundTruth, Lidar, LidarCamera };
 enum class SlamMode { GroundTruth };
 enum class PlannerMode { Oracle, Delaunay };
 

@@ -130,38 +130,38 @@ void add_vehicle_fields(std::vector<Field>& f) {
 
 #define ACC(member) [](auto& s) -> auto& { return s.member; }
 
-// [perception]: the object-level cone sensor (perception = ground_truth)
-void add_perception_fields(std::vector<Field>& f) {
-  f.push_back(real_field("perception", "mount_x", "m", -10.0, 10.0, "sensor position ahead of the rear axle", ACC(perception.mount_x)));
-  f.push_back(real_field("perception", "mount_y", "m", -5.0, 5.0, "sensor position left of the centre", ACC(perception.mount_y)));
-  f.push_back(real_field("perception", "range_min", "m", 0.0, 1000.0, "nearest cone seen", ACC(perception.range_min)));
-  f.push_back(real_field("perception", "range_max", "m", 0.1, 1000.0, "farthest cone seen", ACC(perception.range_max)));
-  f.push_back(real_field("perception", "fov", "rad", 0.01, 2.0 * kPi, "horizontal field of view, centred forward", ACC(perception.fov)));
-  f.push_back(bool_field("perception", "occlusion", "cones hide cones behind them", ACC(perception.occlusion)));
-  f.push_back(real_field("perception", "occlusion_fraction", "", 0.0, 1.0, "share of a cone's bearing that must be covered to hide it",
-                         ACC(perception.occlusion_fraction)));
-  f.push_back(real_field("perception", "range_noise", "m", 0.0, 10.0, "range noise std at 0 m", ACC(perception.range_noise)));
-  f.push_back(real_field("perception", "range_noise_per_m", "m/m", 0.0, 1.0, "growth of the range noise std with range",
-                         ACC(perception.range_noise_per_m)));
-  f.push_back(real_field("perception", "bearing_noise", "rad", 0.0, 1.0, "bearing noise std", ACC(perception.bearing_noise)));
-  f.push_back(real_field("perception", "miss_probability", "", 0.0, 1.0, "chance a cone in view is missed, near",
-                         ACC(perception.miss_probability)));
-  f.push_back(real_field("perception", "miss_probability_growth", "", 0.0, 1.0, "added at range_max (quadratic in range)",
-                         ACC(perception.miss_probability_growth)));
-  f.push_back(real_field("perception", "unknown_color_probability", "", 0.0, 1.0, "chance of no colour, near",
-                         ACC(perception.unknown_color_probability)));
-  f.push_back(real_field("perception", "unknown_color_growth", "", 0.0, 1.0, "added at range_max (quadratic in range)",
-                         ACC(perception.unknown_color_growth)));
-  f.push_back(real_field("perception", "color_flip_probability", "", 0.0, 1.0, "chance of the look-alike colour, near",
-                         ACC(perception.color_flip_probability)));
-  f.push_back(real_field("perception", "color_flip_growth", "", 0.0, 1.0, "added at range_max (quadratic in range)",
-                         ACC(perception.color_flip_growth)));
-  f.push_back(real_field("perception", "false_positives_per_frame", "", 0.0, 100.0, "mean ghost cones per frame (Poisson)",
-                         ACC(perception.false_positives_per_frame)));
-  f.push_back(real_field("perception", "false_positive_unknown_probability", "", 0.0, 1.0, "share of ghosts without colour",
-                         ACC(perception.false_positive_unknown_probability)));
-  f.push_back(real_field("perception", "latency", "s", 0.0, 10.0, "measurement to delivery", ACC(perception.latency)));
-  f.push_back(real_field("perception", "rate", "Hz", 0.1, 1000.0, "frames per second", ACC(perception.rate)));
+// [cone_sensor]: the object-level cone sensor (perception = ground_truth)
+void add_cone_sensor_fields(std::vector<Field>& f) {
+  f.push_back(real_field("cone_sensor", "mount_x", "m", -10.0, 10.0, "sensor position ahead of the rear axle", ACC(cone_sensor.mount_x)));
+  f.push_back(real_field("cone_sensor", "mount_y", "m", -5.0, 5.0, "sensor position left of the centre", ACC(cone_sensor.mount_y)));
+  f.push_back(real_field("cone_sensor", "range_min", "m", 0.0, 1000.0, "nearest cone seen", ACC(cone_sensor.range_min)));
+  f.push_back(real_field("cone_sensor", "range_max", "m", 0.1, 1000.0, "farthest cone seen", ACC(cone_sensor.range_max)));
+  f.push_back(real_field("cone_sensor", "fov", "rad", 0.01, 2.0 * kPi, "horizontal field of view, centred forward", ACC(cone_sensor.fov)));
+  f.push_back(bool_field("cone_sensor", "occlusion", "cones hide cones behind them", ACC(cone_sensor.occlusion)));
+  f.push_back(real_field("cone_sensor", "occlusion_fraction", "", 0.0, 1.0, "share of a cone's bearing that must be covered to hide it",
+                         ACC(cone_sensor.occlusion_fraction)));
+  f.push_back(real_field("cone_sensor", "range_noise", "m", 0.0, 10.0, "range noise std at 0 m", ACC(cone_sensor.range_noise)));
+  f.push_back(real_field("cone_sensor", "range_noise_per_m", "m/m", 0.0, 1.0, "growth of the range noise std with range",
+                         ACC(cone_sensor.range_noise_per_m)));
+  f.push_back(real_field("cone_sensor", "bearing_noise", "rad", 0.0, 1.0, "bearing noise std", ACC(cone_sensor.bearing_noise)));
+  f.push_back(real_field("cone_sensor", "miss_probability", "", 0.0, 1.0, "chance a cone in view is missed, near",
+                         ACC(cone_sensor.miss_probability)));
+  f.push_back(real_field("cone_sensor", "miss_probability_growth", "", 0.0, 1.0, "added at range_max (quadratic in range)",
+                         ACC(cone_sensor.miss_probability_growth)));
+  f.push_back(real_field("cone_sensor", "unknown_color_probability", "", 0.0, 1.0, "chance of no colour, near",
+                         ACC(cone_sensor.unknown_color_probability)));
+  f.push_back(real_field("cone_sensor", "unknown_color_growth", "", 0.0, 1.0, "added at range_max (quadratic in range)",
+                         ACC(cone_sensor.unknown_color_growth)));
+  f.push_back(real_field("cone_sensor", "color_flip_probability", "", 0.0, 1.0, "chance of the look-alike colour, near",
+                         ACC(cone_sensor.color_flip_probability)));
+  f.push_back(real_field("cone_sensor", "color_flip_growth", "", 0.0, 1.0, "added at range_max (quadratic in range)",
+                         ACC(cone_sensor.color_flip_growth)));
+  f.push_back(real_field("cone_sensor", "false_positives_per_frame", "", 0.0, 100.0, "mean ghost cones per frame (Poisson)",
+                         ACC(cone_sensor.false_positives_per_frame)));
+  f.push_back(real_field("cone_sensor", "false_positive_unknown_probability", "", 0.0, 1.0, "share of ghosts without colour",
+                         ACC(cone_sensor.false_positive_unknown_probability)));
+  f.push_back(real_field("cone_sensor", "latency", "s", 0.0, 10.0, "measurement to delivery", ACC(cone_sensor.latency)));
+  f.push_back(real_field("cone_sensor", "rate", "Hz", 0.1, 1000.0, "frames per second", ACC(cone_sensor.rate)));
 }
 
 // [imu], [wheel_speeds], [steering_sensor]: the odometry sensors
@@ -182,6 +182,39 @@ void add_odometry_fields(std::vector<Field>& f) {
   f.push_back(real_field("steering_sensor", "noise", "rad", 0.0, 1.0, "noise std", ACC(steering_sensor.noise)));
   f.push_back(real_field("steering_sensor", "resolution", "rad", 0.0, 1.0, "quantisation step (0: none)", ACC(steering_sensor.resolution)));
   f.push_back(real_field("steering_sensor", "offset", "rad", -1.5, 1.5, "calibration offset", ACC(steering_sensor.offset)));
+}
+
+// [lidar]: the rotating LiDAR; [ground]: the ground's shape the sensors see
+// (the vehicle model stays planar)
+void add_lidar_fields(std::vector<Field>& f) {
+  f.push_back(int_field("lidar", "channels", "", 1, 65535, "channels, evenly spaced in elevation", ACC(lidar.channels)));
+  f.push_back(real_field("lidar", "elevation_min", "rad", -kPi / 2, kPi / 2, "lowest channel's elevation", ACC(lidar.elevation_min)));
+  f.push_back(real_field("lidar", "elevation_max", "rad", -kPi / 2, kPi / 2, "highest channel's elevation", ACC(lidar.elevation_max)));
+  f.push_back(int_field("lidar", "columns", "", 1, 100000, "columns per rotation", ACC(lidar.columns)));
+  f.push_back(real_field("lidar", "rate", "Hz", 0.1, 1000.0, "rotations per second", ACC(lidar.rate)));
+  f.push_back(real_field("lidar", "range_min", "m", 0.0, 1000.0, "blind zone", ACC(lidar.range_min)));
+  f.push_back(real_field("lidar", "range_max", "m", 0.1, 1000.0, "farthest return", ACC(lidar.range_max)));
+  f.push_back(real_field("lidar", "range_noise", "m", 0.0, 10.0, "range noise std along the ray", ACC(lidar.range_noise)));
+  f.push_back(real_field("lidar", "dropout", "", 0.0, 0.99, "chance a ray returns nothing", ACC(lidar.dropout)));
+  f.push_back(real_field("lidar", "mount_x", "m", -10.0, 10.0, "optical centre ahead of the rear axle", ACC(lidar.mount_x)));
+  f.push_back(real_field("lidar", "mount_y", "m", -5.0, 5.0, "optical centre left of the centre", ACC(lidar.mount_y)));
+  f.push_back(real_field("lidar", "mount_z", "m", 0.01, 5.0, "optical centre above the ground", ACC(lidar.mount_z)));
+  f.push_back(real_field("lidar", "mount_pitch", "rad", -0.5, 0.5, "pitch, > 0 nose down", ACC(lidar.mount_pitch)));
+  f.push_back(real_field("lidar", "reflect_white", "", 0.0, 1.0, "reflectivity of a white stripe", ACC(lidar.reflect_white)));
+  f.push_back(real_field("lidar", "reflect_yellow", "", 0.0, 1.0, "reflectivity of a yellow body", ACC(lidar.reflect_yellow)));
+  f.push_back(real_field("lidar", "reflect_orange", "", 0.0, 1.0, "reflectivity of an orange body", ACC(lidar.reflect_orange)));
+  f.push_back(real_field("lidar", "reflect_blue", "", 0.0, 1.0, "reflectivity of a blue body", ACC(lidar.reflect_blue)));
+  f.push_back(real_field("lidar", "reflect_black", "", 0.0, 1.0, "reflectivity of a black stripe", ACC(lidar.reflect_black)));
+  f.push_back(real_field("lidar", "reflect_grey", "", 0.0, 1.0, "reflectivity of a cone of unknown colour", ACC(lidar.reflect_grey)));
+  f.push_back(real_field("lidar", "reflect_ground", "", 0.0, 1.0, "reflectivity of the asphalt", ACC(lidar.reflect_ground)));
+  f.push_back(real_field("lidar", "intensity_range_ref", "m", 0.01, 1000.0, "intensity falls off as (ref / r)^2 beyond this",
+                         ACC(lidar.intensity_range_ref)));
+  f.push_back(real_field("lidar", "intensity_noise", "", 0.0, 1.0, "intensity noise std", ACC(lidar.intensity_noise)));
+  f.push_back(real_field("ground", "slope_x", "", -1.0, 1.0, "dz/dx of the ground plane (map frame)", ACC(ground.slope_x)));
+  f.push_back(real_field("ground", "slope_y", "", -1.0, 1.0, "dz/dy of the ground plane (map frame)", ACC(ground.slope_y)));
+  f.push_back(real_field("ground", "bump_height", "m", 0.0, 1.0, "amplitude of the sinusoidal bumps", ACC(ground.bump_height)));
+  f.push_back(real_field("ground", "bump_wavelength", "m", 0.1, 1000.0, "wavelength of the bumps", ACC(ground.bump_wavelength)));
+  f.push_back(real_field("ground", "cell", "m", 0.01, 100.0, "height-field grid cell (a lower bound)", ACC(ground.cell)));
 }
 
 // [cones]: the Box2D cone world's physics
@@ -231,7 +264,9 @@ std::vector<Field> build_fields() {
   // [autonomy]
   using namespace stack;
   f.push_back(enum_field<PerceptionMode>("autonomy", "perception", "where the cones come from",
-                                         {{"ground_truth", PerceptionMode::GroundTruth}}, ACC(autonomy.perception)));
+                                         {{"ground_truth", PerceptionMode::GroundTruth}, {"lidar", PerceptionMode::Lidar},
+                                          {"lidar_camera", PerceptionMode::LidarCamera}},
+                                         ACC(autonomy.perception)));
   f.push_back(enum_field<SlamMode>("autonomy", "slam", "where the pose comes from", {{"ground_truth", SlamMode::GroundTruth}},
                                    ACC(autonomy.slam)));
   f.push_back(enum_field<PlannerMode>("autonomy", "planner", "where the reference path comes from",
@@ -366,9 +401,10 @@ std::vector<Field> build_fields() {
   f.push_back(int_field("sim", "control_rate", "Hz", 1, 100000, "stack cycle rate", ACC(sim.control_rate)));
   f.push_back(int_field("sim", "log_rate", "Hz", 1, 100000, "log.csv rows and off-course checks", ACC(sim.log_rate)));
 
-  // [perception], [vehicle] and [cones]: see add_perception_fields, add_vehicle_fields and add_cone_fields
-  add_perception_fields(f);
+  // [cone_sensor], [vehicle] and [cones]: see add_cone_sensor_fields, add_vehicle_fields and add_cone_fields
+  add_cone_sensor_fields(f);
   add_odometry_fields(f);
+  add_lidar_fields(f);
   add_vehicle_fields(f);
   add_cone_fields(f);
 
@@ -499,11 +535,13 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
                     " Hz) must be a whole multiple of control_rate and log_rate");
   }
   if (const char* why = control::validate(s.control, stack_params(s).vehicle)) throw UserError(path + ": [control] " + why);
-  if (const std::string why = sensors::validate(s.perception); !why.empty()) throw UserError(path + ": [perception] " + why);
+  if (const std::string why = sensors::validate(s.cone_sensor); !why.empty()) throw UserError(path + ": [cone_sensor] " + why);
   if (const auto why = planning::validate(s.planning)) throw UserError(path + ": [planning] " + *why);
   if (const std::string why = sensors::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
   if (const std::string why = sensors::validate(s.wheel_speeds); !why.empty()) throw UserError(path + ": [wheel_speeds] " + why);
   if (const std::string why = sensors::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
+  if (const std::string why = sensors::validate(s.lidar); !why.empty()) throw UserError(path + ": [lidar] " + why);
+  if (const std::string why = sensors::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
 
   s.source = path;
   s.name = std::filesystem::path(path).stem().string();

@@ -11,6 +11,7 @@
 #include "sim/events/event.h"
 #include "sim/sensors/cone_sensor.h"
 #include "sim/sensors/imu.h"
+#include "sim/sensors/lidar.h"
 #include "sim/sensors/odometry_sensors.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
@@ -56,10 +57,12 @@ struct Scenario {
 
   ScenarioSection scenario;
   stack::AutonomyModes autonomy;
-  sensors::ConeSensorParams perception;  // the cone sensor of perception = ground_truth
+  sensors::ConeSensorParams cone_sensor;  // [cone_sensor]: the object-level sensor of perception = ground_truth
   sensors::ImuParams imu;                 // [imu]
   sensors::WheelSpeedParams wheel_speeds;  // [wheel_speeds]
   sensors::SteeringSensorParams steering_sensor;  // [steering_sensor]
+  sensors::LidarParams lidar;             // [lidar]: the rotating LiDAR of perception = lidar, lidar_camera
+  sensors::GroundParams ground;           // [ground]: the ground's shape, as the sensors see it
   vehicle::VehicleParams vehicle;
   control::ControlParams control;
   planning::PathPlannerParams planning;

@@ -1,9 +1,11 @@
 #include "sim/runner/simulation.h"
 
 #include <chrono>
+#include <memory>
 #include <deque>
 #include <cmath>
 
+#include "sim/runner/raw_sensors.h"
 #include "sim/runner/sim_hal.h"
 #include "sim/sensors/cone_sensor.h"
 #include "sim/sensors/imu.h"
@@ -133,7 +135,7 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
 
   // perception = ground_truth: the object-level cone sensor, on its own random
   // stream of the scenario's seed, its frames delivered after their latency
-  sensors::ConeSensorParams sensor_params = sc.perception;
+  sensors::ConeSensorParams sensor_params = sc.cone_sensor;
   sensor_params.small_cone_radius = 0.5 * sc.cones.small_cone.base_width;
   sensor_params.big_cone_radius = 0.5 * sc.cones.big_cone.base_width;
   sensors::ConeSensor sensor(sensor_params, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 1);
@@ -150,6 +152,11 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   const long imu_every = every(sc.imu.rate), wheels_every = every(sc.wheel_speeds.rate),
              steering_every = every(sc.steering_sensor.rate);
 
+  // perception = lidar | lidar_camera: the raw sensors instead of the cone sensor
+  const bool raw_perception = sc.autonomy.perception != stack::PerceptionMode::GroundTruth;
+  std::unique_ptr<RawSensors> raw;
+  if (raw_perception) raw = std::make_unique<RawSensors>(sc.lidar, sc.ground, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 5);
+
   vehicle::DriverInput input{0.0, 0.0, 1.0};
   hal::AsState as = hal::AsState::Off;
   const TimeNs go_ns = from_seconds(sc.scenario.go_time);
@@ -164,13 +171,19 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
     Pose2 base = vehicle::base_pose(vp, car);
 
     // a perception frame of the cones as they stand now, delivered later
-    if (k % sensor_every == 0) {
+    if (!raw_perception && k % sensor_every == 0) {
       for (int i = 0; i < cones.cone_count(); ++i) {
         const auto u = static_cast<std::size_t>(i);
         seen[u] = {cones.cone_position(i), cones.cone(i).color};
         knocked[u] = cones.cone_knocked(i);
       }
       in_flight.emplace_back(now + sensor.latency_ns(), sensor.measure(seen, knocked, base, now));
+    }
+
+    // a LiDAR rotation that ends now, cast from the poses it was taken at
+    if (raw) {
+      raw->record(now, base);
+      if (raw->rotation_ends(now)) raw->emit(now, cones, hal);
     }
 
     // odometry: the IMU at the base origin's acceleration (from the CG's: a_base = a_cg

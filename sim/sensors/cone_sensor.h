@@ -23,7 +23,7 @@
 
 namespace paddock::sensors {
 
-// every field is the INI key `[perception] <field>`. The defaults describe a
+// every field is the INI key `[cone_sensor] <field>`. The defaults describe a
 // good FS pipeline (a 64-channel 1024-column LiDAR on the nose cone, a camera
 // on the main hoop, as on the paper's FRED-003C); each says why.
 struct ConeSensorParams {

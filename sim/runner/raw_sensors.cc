@@ -1,0 +1,78 @@
+#include "sim/runner/raw_sensors.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace paddock::runner {
+
+RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground, std::uint64_t seed)
+    : lidar_(lidar, seed), ground_(ground) {}
+
+void RawSensors::record(TimeNs now, const Pose2& base) {
+  poses_.emplace_back(now, base);
+  // keep one rotation and a margin
+  while (poses_.size() > 2 && poses_.front().first < now - 2 * lidar_.period_ns()) poses_.pop_front();
+}
+
+bool RawSensors::rotation_ends(TimeNs now) const {
+  const TimeNs period = lidar_.period_ns();
+  return now >= period && now % period == 0;
+}
+
+Pose2 RawSensors::pose_at(TimeNs t) const {
+  if (poses_.empty()) return {};
+  if (t <= poses_.front().first) return poses_.front().second;
+  if (t >= poses_.back().first) return poses_.back().second;
+  const auto it = std::lower_bound(poses_.begin(), poses_.end(), t,
+                                   [](const std::pair<TimeNs, Pose2>& p, TimeNs v) { return p.first < v; });
+  const auto& [t1, p1] = *it;
+  const auto& [t0, p0] = *(it - 1);
+  const double u = static_cast<double>(t - t0) / static_cast<double>(t1 - t0);
+  Pose2 p;
+  p.x = p0.x + u * (p1.x - p0.x);
+  p.y = p0.y + u * (p1.y - p0.y);
+  p.yaw = p0.yaw + u * wrap_angle(p1.yaw - p0.yaw);
+  return p;
+}
+
+void RawSensors::update_scene(const world::ConeWorld& cones) {
+  const auto n = static_cast<std::size_t>(cones.cone_count());
+  bool changed = world_ == nullptr || scene_cones_.size() != n;
+  if (!changed) {
+    for (std::size_t i = 0; i < n && !changed; ++i) {
+      const int ii = static_cast<int>(i);
+      changed = cones.cone_knocked(ii) != scene_knocked_[i] ||
+                distance(cones.cone_position(ii), scene_cones_[i].position) > 0.01;
+    }
+  }
+  if (!changed) return;
+  scene_cones_.resize(n);
+  scene_knocked_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int ii = static_cast<int>(i);
+    scene_cones_[i] = {cones.cone_position(ii), cones.cone(ii).color};
+    scene_knocked_[i] = cones.cone_knocked(ii);
+  }
+  world_.reset();  // one Embree device at a time
+  world_ = std::make_unique<sensors::LidarWorld>(scene_cones_, scene_knocked_, ground_);
+}
+
+const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeWorld& cones, SimHal& hal) {
+  update_scene(cones);
+  const TimeNs start = now - lidar_.period_ns();
+  const std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [this](TimeNs t) { return pose_at(t); }, start);
+  hal::LidarScan scan;
+  scan.stamp = start;
+  scan.end = lidar_.column_time(start, lidar_.params().columns - 1);
+  scan.points.resize(raw.size());
+  truth_.resize(raw.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const sensors::LidarPoint& p = raw[i];
+    scan.points[i] = hal::LidarPoint{p.x, p.y, p.z, p.intensity, p.ring, p.t};
+    truth_[i] = p.cone;
+  }
+  hal.post(std::move(scan));
+  return truth_;
+}
+
+}  // namespace paddock::runner

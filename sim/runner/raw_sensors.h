@@ -1,0 +1,52 @@
+#pragma once
+// the raw perception sensors of perception = lidar | lidar_camera in the
+// closed loop: the rotating LiDAR (and the camera it triggers) ray-cast the
+// cone world as it stands, from the car's pose at each column's own time.
+//
+// The loop records the base pose every physics step; when a rotation is over,
+// the whole scan is cast from the recorded poses of that rotation (each column
+// from the pose at its own time, interpolated between physics steps), and
+// posted to the HAL as it would arrive from the driver: at the end of the
+// rotation. The Embree scene is rebuilt only when a cone moved or fell.
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "autonomy/hal/messages.h"
+#include "sim/runner/sim_hal.h"
+#include "sim/sensors/lidar.h"
+#include "sim/world/cone_world.h"
+
+namespace paddock::runner {
+
+class RawSensors {
+ public:
+  RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground, std::uint64_t seed);
+
+  // the base pose at `now` (call every physics step, times increasing)
+  void record(TimeNs now, const Pose2& base);
+  // true when a rotation ends at `now` (one starts at 0, then every period)
+  bool rotation_ends(TimeNs now) const;
+  // casts the rotation that ends at `now` against the cones as they stand and
+  // posts the scan; returns its ground truth: per point the cone index hit
+  // (-1 the ground), in the order of the scan's points
+  const std::vector<std::int32_t>& emit(TimeNs now, const world::ConeWorld& cones, SimHal& hal);
+
+  TimeNs period_ns() const { return lidar_.period_ns(); }
+
+ private:
+  Pose2 pose_at(TimeNs t) const;
+  void update_scene(const world::ConeWorld& cones);
+
+  sensors::Lidar lidar_;
+  sensors::GroundParams ground_;
+  std::unique_ptr<sensors::LidarWorld> world_;
+  std::vector<Cone> scene_cones_;
+  std::vector<bool> scene_knocked_;
+  std::deque<std::pair<TimeNs, Pose2>> poses_;  // the last rotation and a bit, oldest first
+  std::vector<std::int32_t> truth_;
+};
+
+}  // namespace paddock::runner
