@@ -19,6 +19,15 @@ const char* to_string(Mission m) {
   return "trackdrive";
 }
 
+const char* to_string(PerceptionMode m) {
+  switch (m) {
+    case PerceptionMode::GroundTruth: return "ground_truth";
+    case PerceptionMode::Lidar: return "lidar";
+    case PerceptionMode::LidarCamera: return "lidar_camera";
+  }
+  return "ground_truth";
+}
+
 Stack::Stack(const StackParams& params, MissionSpec spec)
     : params_(params),
       spec_(std::move(spec)),
@@ -65,6 +74,8 @@ std::optional<Pose2> Stack::pose_at(TimeNs t) const {
 }
 
 void Stack::on_detections(const hal::ConeDetections& d) {
+  last_detections_ = d;
+  ++detection_frames_;
   // slam = ground_truth: the detections go into the map at the pose the car had when they were measured
   const std::optional<Pose2> pose = pose_at(d.stamp);
   if (!pose) return;

@@ -126,6 +126,10 @@ class Stack {
   // the map the last plan was made on (its triangulation indexes these)
   const std::vector<Cone>& last_plan_cones() const { return last_plan_cones_; }
   const std::vector<Segment>& gates() const { return gates_; }
+  // the last frame of cones perception delivered (base frame at its stamp) and
+  // how many frames came so far: for the perception metrics
+  const hal::ConeDetections& last_detections() const { return last_detections_; }
+  long detection_frames() const { return detection_frames_; }
 
  private:
   void on_message(const hal::SensorMessage& m);
@@ -149,6 +153,8 @@ class Stack {
   std::deque<hal::StateEstimate> history_;  // the last second of state estimates, oldest first
   slam::ConeMap cone_map_;
   bool map_news_ = false;                   // detections since the last plan
+  hal::ConeDetections last_detections_;
+  long detection_frames_ = 0;
   planning::PlanResult last_plan_;
   std::vector<Cone> last_plan_cones_;
   Trajectory pending_lap_;                  // the closed lap, waiting for a smooth handover
@@ -165,5 +171,7 @@ class Stack {
 };
 
 const char* to_string(Mission m);
+// the scenario's names: ground_truth, lidar, lidar_camera
+const char* to_string(PerceptionMode m);
 
 }  // namespace paddock::stack

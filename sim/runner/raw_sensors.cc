@@ -5,21 +5,29 @@
 
 namespace paddock::runner {
 
-RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground, std::uint64_t seed)
-    : lidar_(lidar, seed), ground_(ground) {}
-
-void RawSensors::record(TimeNs now, const Pose2& base) {
+void PoseHistory::record(TimeNs now, const Pose2& base) {
   poses_.emplace_back(now, base);
-  // keep one rotation and a margin
-  while (poses_.size() > 2 && poses_.front().first < now - 2 * lidar_.period_ns()) poses_.pop_front();
+  while (poses_.size() > 2 && poses_.front().first < now - span_) poses_.pop_front();
 }
+
+std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t cone_count) {
+  std::vector<bool> hit(cone_count, false);
+  for (const std::int32_t c : truth)
+    if (c >= 0 && static_cast<std::size_t>(c) < cone_count) hit[static_cast<std::size_t>(c)] = true;
+  return hit;
+}
+
+RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground, std::uint64_t seed)
+    : lidar_(lidar, seed), ground_(ground), poses_(2 * lidar_.period_ns()) {}
+
+void RawSensors::record(TimeNs now, const Pose2& base) { poses_.record(now, base); }
 
 bool RawSensors::rotation_ends(TimeNs now) const {
   const TimeNs period = lidar_.period_ns();
   return now >= period && now % period == 0;
 }
 
-Pose2 RawSensors::pose_at(TimeNs t) const {
+Pose2 PoseHistory::at(TimeNs t) const {
   if (poses_.empty()) return {};
   if (t <= poses_.front().first) return poses_.front().second;
   if (t >= poses_.back().first) return poses_.back().second;
@@ -60,7 +68,7 @@ void RawSensors::update_scene(const world::ConeWorld& cones) {
 const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeWorld& cones, SimHal& hal) {
   update_scene(cones);
   const TimeNs start = now - lidar_.period_ns();
-  const std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [this](TimeNs t) { return pose_at(t); }, start);
+  const std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [this](TimeNs t) { return poses_.at(t); }, start);
   hal::LidarScan scan;
   scan.stamp = start;
   scan.end = lidar_.column_time(start, lidar_.params().columns - 1);

@@ -21,6 +21,22 @@
 
 namespace paddock::runner {
 
+// the base poses of the last `span` of simulation time, interpolated between
+// the recorded steps (clamped at the ends)
+class PoseHistory {
+ public:
+  explicit PoseHistory(TimeNs span) : span_(span) {}
+  void record(TimeNs now, const Pose2& base);
+  Pose2 at(TimeNs t) const;
+
+ private:
+  TimeNs span_;
+  std::deque<std::pair<TimeNs, Pose2>> poses_;  // oldest first
+};
+
+// per cone of the world, whether a scan hit it with at least one point
+std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t cone_count);
+
 class RawSensors {
  public:
   RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground, std::uint64_t seed);
@@ -37,7 +53,6 @@ class RawSensors {
   TimeNs period_ns() const { return lidar_.period_ns(); }
 
  private:
-  Pose2 pose_at(TimeNs t) const;
   void update_scene(const world::ConeWorld& cones);
 
   sensors::Lidar lidar_;
@@ -45,7 +60,7 @@ class RawSensors {
   std::unique_ptr<sensors::LidarWorld> world_;
   std::vector<Cone> scene_cones_;
   std::vector<bool> scene_knocked_;
-  std::deque<std::pair<TimeNs, Pose2>> poses_;  // the last rotation and a bit, oldest first
+  PoseHistory poses_;  // the last rotation and a bit
   std::vector<std::int32_t> truth_;
 };
 

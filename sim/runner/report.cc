@@ -86,6 +86,28 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
     << ", total " << fixed(ev.total_time, 3) << " s\n";
   o << "  tracking    rms " << fixed(r.tracking.rms, 3) << " m, max " << fixed(r.tracking.max, 3) << " m, ITAE "
     << fixed(r.tracking.itae, 1) << " (mean per lap)\n";
+  if (r.perception.frames() > 0) {
+    o << "  perception  " << stack::to_string(s.autonomy.perception) << ", " << r.perception.frames()
+      << " frames against the truth (recall over the cones the sensor "
+      << (s.autonomy.perception == stack::PerceptionMode::GroundTruth ? "had in view, unoccluded" : "hit with a point")
+      << ")\n";
+    o << "    range [m]  precision  recall  colour  error mean/max [m]  detections\n";
+    std::vector<RangeBinStats> rows = r.perception.bins();
+    rows.push_back(r.perception.total());
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const RangeBinStats& b = rows[i];
+      if (b.detections == 0 && b.visible == 0) continue;
+      const std::string range = i + 1 == rows.size() ? "all" : std::isinf(b.range_max) ? fixed(b.range_min, 0) + "+"
+                                                     : fixed(b.range_min, 0) + "-" + fixed(b.range_max, 0);
+      auto pct = [](double v) { return std::isnan(v) ? std::string("   -") : fixed(100.0 * v, 1) + "%"; };
+      auto len = [](double v) { return std::isnan(v) ? std::string("-") : fixed(v, 3); };
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "    %-9s  %9s  %6s  %6s  %8s / %-7s  %ld\n", range.c_str(), pct(b.precision()).c_str(),
+                    pct(b.recall()).c_str(), pct(b.colour_accuracy()).c_str(), len(b.error_mean()).c_str(),
+                    len(b.error_count > 0 ? b.error_max : std::nan("")).c_str(), b.detections);
+      o << buf;
+    }
+  }
   o << "  stack       " << r.fallbacks << " fallback cycles" << (r.fault.empty() ? "" : ", last fault: " + r.fault) << "\n";
   o << "  speed       " << fixed(r.sim_time, 1) << " s simulated in " << fixed(r.wall_time, 3) << " s ("
     << fixed(r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0, 0) << "x real time)\n";
@@ -113,6 +135,27 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
     cones.push_back({{"x", c.position.x}, {"y", c.position.y}, {"color", std::string(cone_tag(c.color))},
                      {"t", c.t}, {"cause", c.knocked ? "knocked" : "displaced"}});
   }
+  Json bins = Json::array();
+  auto bin_json = [](const RangeBinStats& b) {
+    // NaN (nothing to count) is written as null
+    return Json{{"range_min", b.range_min},
+                {"range_max", std::isinf(b.range_max) ? Json(nullptr) : Json(b.range_max)},
+                {"precision", b.precision()},
+                {"recall", b.recall()},
+                {"colour_accuracy", b.colour_accuracy()},
+                {"position_error_mean", b.error_mean()},
+                {"position_error_max", b.error_count > 0 ? Json(b.error_max) : Json(nullptr)},
+                {"detections", b.detections},
+                {"detections_matched", b.detections_matched},
+                {"visible", b.visible},
+                {"visible_matched", b.visible_matched},
+                {"colour_unknown", b.colour_unknown}};
+  };
+  for (const RangeBinStats& b : r.perception.bins()) bins.push_back(bin_json(b));
+  const Json perception = {{"mode", stack::to_string(s.autonomy.perception)},
+                           {"frames", r.perception.frames()},
+                           {"bins", bins},
+                           {"all", bin_json(r.perception.total())}};
   const double penalty_s = rules.doo_penalty * ev.doo + rules.oc_penalty * ev.oc + rules.uss_penalty * ev.uss;
   // JSON has no NaN or infinity: nlohmann writes them as null
   const Json j = {
@@ -130,6 +173,7 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"wall_time", r.wall_time},
       {"realtime_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0},
       {"tracking", tracking(r.tracking.rms, r.tracking.max, r.tracking.itae)},
+      {"perception", perception},
       {"stack", {{"fallbacks", r.fallbacks}, {"fault", r.fault}}},
       {"expectations_failed", failed},
   };

@@ -157,6 +157,17 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   std::unique_ptr<RawSensors> raw;
   if (raw_perception) raw = std::make_unique<RawSensors>(sc.lidar, sc.ground, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 5);
 
+  // perception metrics: each frame the stack got, against the truth of its instant
+  PerceptionMetrics metrics;
+  PoseHistory truth_poses(kNsPerSecond);
+  // (frame stamp, cones the sensor could see): the LiDAR hit them, or the
+  // cone sensor had them in view unoccluded
+  std::deque<std::pair<TimeNs, std::vector<bool>>> scan_visible;
+  const Vec2 sensor_mount = raw_perception ? Vec2{sc.lidar.mount_x, sc.lidar.mount_y}
+                                           : Vec2{sc.cone_sensor.mount_x, sc.cone_sensor.mount_y};
+  long scored_frames = 0;
+  std::vector<Cone> truth_cones(static_cast<std::size_t>(cones.cone_count()));
+
   vehicle::DriverInput input{0.0, 0.0, 1.0};
   hal::AsState as = hal::AsState::Off;
   const TimeNs go_ns = from_seconds(sc.scenario.go_time);
@@ -178,12 +189,20 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
         knocked[u] = cones.cone_knocked(i);
       }
       in_flight.emplace_back(now + sensor.latency_ns(), sensor.measure(seen, knocked, base, now));
+      scan_visible.emplace_back(now, sensor.last_visible());
+      while (scan_visible.size() > 4) scan_visible.pop_front();
     }
 
     // a LiDAR rotation that ends now, cast from the poses it was taken at
+    truth_poses.record(now, base);
     if (raw) {
       raw->record(now, base);
-      if (raw->rotation_ends(now)) raw->emit(now, cones, hal);
+      if (raw->rotation_ends(now)) {
+        const std::vector<std::int32_t>& hit_truth = raw->emit(now, cones, hal);
+        const TimeNs end = now - raw->period_ns() / sc.lidar.columns;  // the last column's time
+        scan_visible.emplace_back(end, cones_hit(hit_truth, truth_cones.size()));
+        while (scan_visible.size() > 4) scan_visible.pop_front();
+      }
     }
 
     // odometry: the IMU at the base origin's acceleration (from the CG's: a_base = a_cg
@@ -217,6 +236,16 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
         event.start(t);
       }
       stack.tick(now, hal);
+      if (stack.detection_frames() > scored_frames) {
+        scored_frames = stack.detection_frames();
+        const hal::ConeDetections& d = stack.last_detections();
+        for (std::size_t i = 0; i < truth_cones.size(); ++i)
+          truth_cones[i] = {cones.cone_position(static_cast<int>(i)), cones.cone(static_cast<int>(i)).color};
+        std::vector<bool> visible;
+        for (const auto& [stamp, hit] : scan_visible)
+          if (std::llabs(stamp - d.stamp) < dt_ns) visible = hit;
+        if (!visible.empty()) metrics.add(d, truth_poses.at(d.stamp), sensor_mount, truth_cones, visible);
+      }
       if (hal.command()) {
         const hal::ActuatorCommand& c = *hal.command();
         input = vehicle::DriverInput{c.steering_angle, c.throttle, c.brake};
@@ -271,6 +300,7 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   }
 
   res.event = event.result();
+  res.perception = metrics;
   res.sim_time = res.log.empty() ? 0.0 : res.log.back().t;
   res.fallbacks = stack.telemetry().fallbacks;
   res.fault = stack.telemetry().last_fault;

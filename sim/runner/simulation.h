@@ -6,6 +6,7 @@
 
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
+#include "sim/runner/perception_metrics.h"
 #include "sim/runner/scenario.h"
 #include "sim/world/track.h"
 
@@ -74,6 +75,7 @@ struct RunResult {
   int fallbacks = 0;       // control cycles in the safe stop
   std::string fault;       // the stack's last fault, if any
   int cycles = 0;          // control cycles run
+  PerceptionMetrics perception;  // the stack's perceived cones against the truth, per range bin
 };
 
 // the mission the car is given for an event on a track (planner = oracle: also

@@ -156,6 +156,7 @@ hal::ConeDetections ConeSensor::measure(const std::vector<Cone>& cones, const st
   // standing cone within range_max is a candidate, also those nearer than
   // range_min or outside the field of view: they still hide cones behind them.
   candidates_.clear();
+  visible_.assign(cones.size(), false);
   for (std::size_t i = 0; i < cones.size(); ++i) {
     const Vec2 d = cones[i].position - origin;
     const double d2 = squared_norm(d);
@@ -214,6 +215,7 @@ hal::ConeDetections ConeSensor::measure(const std::vector<Cone>& cones, const st
       ++stats_.occluded;
       continue;
     }
+    visible_[k.index] = true;
 
     // five draws per cone in view, whatever the parameters, so that turning
     // one effect off does not reshuffle the others

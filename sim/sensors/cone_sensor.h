@@ -142,6 +142,9 @@ class ConeSensor {
 
   const ConeSensorParams& params() const { return params_; }
   const ConeSensorFrameStats& last_stats() const { return stats_; }
+  // per cone of the last measure() call: in range and field of view, standing
+  // and not hidden (whether or not then missed): the cones it could see
+  const std::vector<bool>& last_visible() const { return visible_; }
   // the latency and frame period in integer nanoseconds
   TimeNs latency_ns() const { return from_seconds(params_.latency); }
   TimeNs period_ns() const { return from_seconds(1.0 / params_.rate); }
@@ -170,6 +173,7 @@ class ConeSensor {
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
   ConeSensorFrameStats stats_;
+  std::vector<bool> visible_;
   // scratch, kept to avoid allocating every frame
   std::vector<Candidate> candidates_;
   std::vector<Interval> covered_;  // disjoint, sorted by lo
