@@ -169,4 +169,60 @@ std::vector<std::uint8_t> encode_png(const Image& image);
 // a PNG file's bytes as an image (libpng); throws RenderError
 Image decode_png(const std::vector<std::uint8_t>& png);
 
+// ---- the perception figures (the paper's LiDAR segmentation and fusion figures) ----
+// (render/perception_figures.cc)
+
+// one LiDAR return in the vehicle base frame (m: x forward, y left); label:
+// 0 ground, 1 non-ground, 2 cone point (any other label is drawn as non-ground)
+struct LidarViewPoint { float x, y; std::uint8_t label; };
+
+struct LidarViewData {
+  std::string title;
+  std::vector<LidarViewPoint> points;   // one scan, motion-corrected, base frame (x forward, y left)
+  std::vector<Cone> detected;           // the cones perception output (base frame), drawn as green circles with
+                                        // a thin ring of their colour (unknown: grey)
+  std::vector<Cone> truth;              // optional: the true cones (base frame) as small hollow black squares
+  double range = 25.0;                  // m (finite, > 0): the window, see draw_lidar_view
+};
+
+// a top-down view of one scan in the base frame, forward UP the page and left
+// to the LEFT: the horizontal axis is y (increasing to the left), the vertical
+// axis x. The window is at least x in [-range/3, range] and y in
+// [-range/2, range/2]; equal aspect, the range that is short for the plot box's
+// shape grows about its centre (a square figure shows y in about +-2/3 range).
+// Points are 1-2 px squares (ground blue, non-ground red, cone points green,
+// drawn in that order, outside the window left out), the detected cones green
+// discs ringed in their colour, the true cones hollow black squares, the car a
+// dark triangle at the origin pointing +x. The legend stands in a row above the
+// plot (right of it when the row is too wide).
+// axes[0] maps (y, x): the pixel of base-frame point p is to_pixel({p.y, p.x})
+// (x_min > x_max there: x_min is the left edge, the largest y).
+// Boxes: "title", "legend", "x_label", "y_label". RenderError: a bad style, a
+// bad range.
+Figure draw_lidar_view(const LidarViewData& data, const FigureStyle& style);
+
+// a detector box in camera image pixels (x right, y down, origin at the image's top-left corner)
+struct CameraBox { double x_min, y_min, x_max, y_max; ConeColor color; };
+
+struct CameraViewData {
+  std::string title;
+  int width = 0, height = 0;              // the camera image's size (px), both > 0
+  std::vector<std::uint8_t> rgb;          // row-major, 3 bytes a pixel, row 0 at the top; empty: no image
+                                          // (a light grey field of width x height)
+  std::vector<CameraBox> boxes;           // the detector's boxes, outlined in their class colour (unknown: grey)
+  std::vector<Vec2> projected;            // LiDAR cluster centres projected to pixels: green crosses
+  std::vector<Vec2> dropped;              // projected centres fusion dropped: red crosses (optional)
+};
+
+// the camera image filling the axes (nearest-neighbour, one scale for x and y,
+// the plot box having the image's aspect), the boxes outlined 2 pt wide, the
+// crosses, a legend in a row above, a title. Axes in image pixels: axes[0] has
+// x_min = 0, x_max = width, y_min = height, y_max = 0 (flipped), so
+// to_pixel({u, v}) of continuous image coordinates (u right, v down; image
+// pixel (i, j) covers [i, i + 1) x [j, j + 1)) is the figure pixel: image
+// pixel (i, j) is drawn under to_pixel({i + 0.5, j + 0.5}).
+// Boxes: "title", "legend", "x_label", "y_label". RenderError: a bad style,
+// width or height <= 0, rgb.size() != width * height * 3 (when not empty).
+Figure draw_camera_view(const CameraViewData& data, const FigureStyle& style);
+
 }  // namespace paddock::render
