@@ -1,0 +1,227 @@
+#include "autonomy/perception/cone_filter.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace paddock::perception {
+
+namespace {
+
+bool finite(double v) { return std::isfinite(v); }
+
+// the cones (ORACLES.md): base width and height; the flat top's radius
+constexpr double kSmallBaseRadius = 0.5 * 0.228, kSmallHeight = 0.325;  // m
+constexpr double kBigBaseRadius = 0.5 * 0.285, kBigHeight = 0.505;      // m
+constexpr double kTopRadius = 0.03;                                     // m
+// E(d)'s cone face (ORACLES.md, AMZ)
+constexpr double kExpectHeight = 0.31, kExpectWidth = 0.30;  // m
+
+// the radius of a cone at height h above its base
+double cone_radius(bool big, double h) {
+  const double r0 = big ? kBigBaseRadius : kSmallBaseRadius;
+  const double height = big ? kBigHeight : kSmallHeight;
+  const double f = std::clamp(h / height, 0.0, 1.0);
+  return r0 + (kTopRadius - r0) * f;
+}
+
+}  // namespace
+
+std::string validate(const ConeFilterParams& p) {
+  std::ostringstream os;
+  if (!finite(p.reconstruction_radius) || !(p.reconstruction_radius > 0.0)) {
+    os << "reconstruction_radius must be finite and > 0 m (got " << p.reconstruction_radius << ")";
+  } else if (!finite(p.reconstruction_margin) || !(p.reconstruction_margin >= 0.0)) {
+    os << "reconstruction_margin must be finite and >= 0 m (got " << p.reconstruction_margin << ")";
+  } else if (p.min_points < 1) {
+    os << "min_points must be >= 1 (got " << p.min_points << ")";
+  } else if (!finite(p.max_extent) || !(p.max_extent > 0.0)) {
+    os << "max_extent must be finite and > 0 m (got " << p.max_extent << ")";
+  } else if (!finite(p.min_height)) {
+    os << "min_height must be finite m (got " << p.min_height << ")";
+  } else if (!finite(p.max_height) || !(p.max_height > p.min_height)) {
+    os << "max_height must be finite and > min_height m (got " << p.max_height << ")";
+  } else if (!finite(p.max_asymmetry) || !(p.max_asymmetry > 0.0)) {
+    os << "max_asymmetry must be finite and > 0 m (got " << p.max_asymmetry << ")";
+  } else if (!finite(p.max_width_growth) || !(p.max_width_growth >= 0.0)) {
+    os << "max_width_growth must be finite and >= 0 m (got " << p.max_width_growth << ")";
+  } else if (!finite(p.min_count_ratio) || !(p.min_count_ratio >= 0.0)) {
+    os << "min_count_ratio must be finite and >= 0 (got " << p.min_count_ratio << ")";
+  } else if (!finite(p.max_count_ratio) || !(p.max_count_ratio > p.min_count_ratio)) {
+    os << "max_count_ratio must be finite and > min_count_ratio (got " << p.max_count_ratio << ")";
+  } else if (!finite(p.big_cone_height) || !(p.big_cone_height > 0.0)) {
+    os << "big_cone_height must be finite and > 0 m (got " << p.big_cone_height << ")";
+  }
+  return os.str();
+}
+
+ConeFilter::ConeFilter(const ConeFilterParams& params, const LidarCalibration& calibration)
+    : params_(params), calib_(calibration) {
+  std::string err = validate(params_);
+  if (!err.empty()) throw std::invalid_argument("ConeFilterParams: " + err);
+  err = validate(calib_);
+  if (!err.empty()) throw std::invalid_argument("LidarCalibration: " + err);
+  // one channel: no vertical spacing; take a narrow 1 deg beam
+  res_v_ = calib_.channels > 1 ? (calib_.elevation_max - calib_.elevation_min) / (calib_.channels - 1)
+                               : kPi / 180.0;
+  res_h_ = 2.0 * kPi / calib_.columns;
+}
+
+double ConeFilter::expected_points(double d) const {
+  d = std::max(d, 1e-3);
+  return 0.5 * kExpectHeight / (2.0 * d * std::tan(0.5 * res_v_)) * kExpectWidth /
+         (2.0 * d * std::tan(0.5 * res_h_));
+}
+
+ConeFilterStats ConeFilter::filter(Cloud& cloud, const GroundSegmenter& ground,
+                                   const Clusters& clusters, std::vector<ConeCluster>& cones,
+                                   std::vector<std::uint32_t>& members) {
+  ConeFilterStats stats;
+  cones.clear();
+  members.clear();
+  std::vector<CloudPoint>& pts = cloud.points;
+  const ConeFilterParams& p = params_;
+  const double sx = calib_.mount_x, sy = calib_.mount_y;
+
+  // the ground returns a cylinder may give back, sorted by x
+  candidates_.clear();
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (pts[i].label == PointLabel::Ground && pts[i].height > p.reconstruction_margin) {
+      candidates_.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  std::sort(candidates_.begin(), candidates_.end(), [&pts](std::uint32_t a, std::uint32_t b) {
+    return pts[a].x < pts[b].x || (pts[a].x == pts[b].x && a < b);
+  });
+  const auto by_x = [&pts](std::uint32_t i, double x) { return pts[i].x < x; };
+
+  const double rr2 = p.reconstruction_radius * p.reconstruction_radius;
+  for (std::size_t k = 0; k < clusters.size(); ++k) {
+    const auto begin = static_cast<std::uint32_t>(members.size());
+    // the cluster's axis: the mean x, y of its returns
+    double mx = 0.0, my = 0.0;
+    for (std::uint32_t m = clusters.offsets[k]; m < clusters.offsets[k + 1]; ++m) {
+      const std::uint32_t i = clusters.members[m];
+      mx += pts[i].x;
+      my += pts[i].y;
+      members.push_back(i);
+    }
+    const double cn = static_cast<double>(clusters.offsets[k + 1] - clusters.offsets[k]);
+    mx /= cn;
+    my /= cn;
+    const double g = ground.ground_height(mx, my);
+
+    // reconstruction: ground returns in the cylinder, above the margin
+    auto it = std::lower_bound(candidates_.begin(), candidates_.end(), mx - p.reconstruction_radius, by_x);
+    std::size_t readded = 0;
+    for (; it != candidates_.end() && pts[*it].x <= mx + p.reconstruction_radius; ++it) {
+      const CloudPoint& q = pts[*it];
+      const double dx = q.x - mx, dy = q.y - my, h = q.z - g;
+      if (dx * dx + dy * dy <= rr2 && h > p.reconstruction_margin && h < p.max_height) {
+        members.push_back(*it);
+        ++readded;
+      }
+    }
+    const auto end = static_cast<std::uint32_t>(members.size());
+    const int n = static_cast<int>(end - begin);
+
+    // statistics over all its returns: heights above the ground at the axis
+    double ax = 0.0, ay = 0.0, az = 0.0, top = -std::numeric_limits<double>::infinity();
+    double lo_h = std::numeric_limits<double>::infinity();
+    double x0 = lo_h, x1 = -lo_h, y0 = lo_h, y1 = -lo_h;
+    for (std::uint32_t m = begin; m < end; ++m) {
+      CloudPoint& q = pts[members[m]];
+      q.height = static_cast<float>(q.z - g);
+      ax += q.x;
+      ay += q.y;
+      az += q.z;
+      top = std::max(top, static_cast<double>(q.height));
+      lo_h = std::min(lo_h, static_cast<double>(q.height));
+      x0 = std::min(x0, static_cast<double>(q.x));
+      x1 = std::max(x1, static_cast<double>(q.x));
+      y0 = std::min(y0, static_cast<double>(q.y));
+      y1 = std::max(y1, static_cast<double>(q.y));
+    }
+    ax /= n;
+    ay /= n;
+    az /= n;
+    const Vec2 ray{ax - sx, ay - sy};
+    const double d = std::max(norm(ray), 1e-6);
+    const Vec2 u = ray / d, t = left_normal(u);
+
+    const auto reject = [&](std::size_t& counter) {
+      ++counter;
+      members.resize(begin);
+    };
+    if (n < p.min_points) {
+      reject(stats.rejected_count);
+      continue;
+    }
+    if (std::hypot(x1 - x0, y1 - y0) > p.max_extent) {
+      reject(stats.rejected_size);
+      continue;
+    }
+    if (top < p.min_height || top > p.max_height) {
+      reject(stats.rejected_height);
+      continue;
+    }
+    // shape: lateral symmetry, and the upper half no wider than the lower
+    bool bad_shape = false;
+    if (n >= 4) {
+      const double mid_h = 0.5 * (lo_h + top);
+      double t0 = std::numeric_limits<double>::infinity(), t1 = -t0;
+      double lo0 = t0, lo1 = -t0, up0 = t0, up1 = -t0;
+      int n_lo = 0, n_up = 0;
+      for (std::uint32_t m = begin; m < end; ++m) {
+        const CloudPoint& q = pts[members[m]];
+        const double tq = dot(Vec2{q.x - ax, q.y - ay}, t);
+        t0 = std::min(t0, tq);
+        t1 = std::max(t1, tq);
+        if (q.height < mid_h) {
+          lo0 = std::min(lo0, tq);
+          lo1 = std::max(lo1, tq);
+          ++n_lo;
+        } else {
+          up0 = std::min(up0, tq);
+          up1 = std::max(up1, tq);
+          ++n_up;
+        }
+      }
+      // the mean's lateral offset is 0 by construction: compare the middle
+      bad_shape = std::abs(0.5 * (t0 + t1)) > p.max_asymmetry;
+      if (n_lo >= 2 && n_up >= 2 && (up1 - up0) > (lo1 - lo0) + p.max_width_growth) bad_shape = true;
+    }
+    if (bad_shape) {
+      reject(stats.rejected_shape);
+      continue;
+    }
+    const double expected = expected_points(d);
+    if (n < p.min_count_ratio * expected || n > p.max_count_ratio * expected + p.min_points) {
+      reject(stats.rejected_density);
+      continue;
+    }
+
+    // accepted: the axis behind the visible face (see the header)
+    const bool big = top >= p.big_cone_height;
+    double mean_h = 0.0;
+    for (std::uint32_t m = begin; m < end; ++m) mean_h += pts[members[m]].height;
+    mean_h /= n;
+    const double behind = 0.25 * kPi * cone_radius(big, mean_h);
+    ConeCluster c;
+    c.begin = begin;
+    c.end = end;
+    c.centre = Eigen::Vector3d(ax + behind * u.x, ay + behind * u.y, az);
+    c.range = d + behind;
+    c.top = top;
+    c.points = n;
+    cones.push_back(c);
+    for (std::uint32_t m = begin; m < end; ++m) pts[members[m]].label = PointLabel::Cone;
+    stats.reconstructed += readded;
+    ++stats.accepted;
+  }
+  return stats;
+}
+
+}  // namespace paddock::perception

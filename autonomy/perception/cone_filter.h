@@ -1,0 +1,119 @@
+#pragma once
+// cone reconstruction and the rule-based cone filters (paper section "Lidar
+// Perception").
+//
+// Reconstruction: the ground removal takes the returns of a cone's lowest
+// few centimetres with the ground. A vertical cylinder of
+// reconstruction_radius around the cluster's axis (the mean x, y of its
+// returns) gives back the ground-labelled returns inside it that stand more
+// than reconstruction_margin above the local ground plane (and below
+// max_height).
+//
+// Filters, in this order, each counted when it rejects:
+//  - count: fewer than min_points returns;
+//  - size: the x, y bounding box's diagonal beyond max_extent (a big cone's
+//    base is 0.285 m wide);
+//  - height: the top return's height above the ground outside
+//    [min_height, max_height] (small cone 0.325 m, big 0.505 m; the ring at
+//    the sensor's own height, mount_z, hits every cone in range);
+//  - shape: across the line of sight the cone is symmetric (the mean of
+//    its returns' lateral offsets lies within max_asymmetry of the middle of
+//    their extent) and narrows upward (the upper half of its height is at
+//    most max_width_growth wider than the lower half);
+//  - density: the count n against the expected count of ORACLES.md (AMZ)
+//      E(d) = 1/2 * h_c / (2 d tan(r_v / 2)) * w_c / (2 d tan(r_h / 2)),
+//    h_c = 0.31 m, w_c = 0.30 m, r_v, r_h the calibration's vertical and
+//    horizontal resolutions, d the horizontal range from the sensor:
+//    accepted within [min_count_ratio E(d), max_count_ratio E(d)] (the
+//    floor min_points keeps far cones, where E(d) < 1).
+//
+// The centre: a LiDAR sees the near face of a cone, whose returns lie on
+// average pi/4 R in front of its axis (points spread evenly across the chord
+// of a circle of radius R: the mean depth of sqrt(R^2 - y^2) over y in
+// [-R, R] is pi R / 4), R the cone's radius at the returns' mean height (the
+// small or, when its top reaches big_cone_height, the big cone's profile).
+// The axis is the returns' mean x, y moved that far away from the sensor;
+// centre z is the returns' mean z (the centroid's height, what a camera
+// projection of the cluster centre wants). All in the base frame at the
+// reference time.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "autonomy/perception/clustering.h"
+#include "autonomy/perception/ground_segmentation.h"
+#include "autonomy/perception/motion_correction.h"
+
+namespace paddock::perception {
+
+struct ConeFilterParams {
+  // reconstruction: a big cone's base radius (0.1425 m) plus range noise
+  double reconstruction_radius = 0.2;   // m, > 0
+  double reconstruction_margin = 0.02;  // m, >= 0
+  // count floor: two returns (a small cone at 15 m gets 2-3 on one ring)
+  int min_points = 2;  // -, >= 1
+  // size
+  double max_extent = 0.45;  // m, > 0
+  double min_height = 0.08;  // m
+  double max_height = 0.6;   // m, > min_height
+  // shape
+  double max_asymmetry = 0.08;     // m, > 0
+  double max_width_growth = 0.06;  // m, >= 0
+  // density, relative to E(d)
+  double min_count_ratio = 0.2;  // -, >= 0
+  double max_count_ratio = 4.0;  // -, > min_count_ratio; a big cone has ~2x a small one's area
+  // a cluster whose top return reaches this is a big cone (for the centre's
+  // profile; between the small cone's 0.325 m and the big one's 0.505 m)
+  double big_cone_height = 0.42;  // m
+};
+
+// "" when every field is usable, else the first problem, starting with the
+// field name
+std::string validate(const ConeFilterParams& p);
+
+// an accepted cone: its returns are members[begin, end) of the filter's
+// member list (cluster returns and the reconstructed ones)
+struct ConeCluster {
+  std::uint32_t begin = 0, end = 0;
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // m, base frame (see the top)
+  double range = 0.0;   // m, horizontal, from the sensor to the centre
+  double top = 0.0;     // m, the highest return above the local ground
+  int points = 0;
+};
+
+struct ConeFilterStats {
+  std::size_t reconstructed = 0;  // ground returns given back to accepted cones
+  std::size_t rejected_count = 0;
+  std::size_t rejected_size = 0;
+  std::size_t rejected_height = 0;
+  std::size_t rejected_shape = 0;
+  std::size_t rejected_density = 0;
+  std::size_t accepted = 0;
+};
+
+class ConeFilter {
+ public:
+  // throws std::invalid_argument when validate(params) or validate(calibration) fails
+  ConeFilter(const ConeFilterParams& params, const LidarCalibration& calibration);
+
+  // reconstructs and filters every cluster; the accepted ones go to `cones`
+  // (cleared first) and their returns are labelled PointLabel::Cone
+  ConeFilterStats filter(Cloud& cloud, const GroundSegmenter& ground, const Clusters& clusters,
+                         std::vector<ConeCluster>& cones, std::vector<std::uint32_t>& members);
+
+  // E(d) of ORACLES.md for this calibration
+  double expected_points(double d) const;
+
+  const ConeFilterParams& params() const { return params_; }
+
+ private:
+  ConeFilterParams params_;
+  LidarCalibration calib_;
+  double res_v_ = 0.0, res_h_ = 0.0;  // rad
+  std::vector<std::uint32_t> candidates_;  // scratch: ground returns that may be re-added, by x
+};
+
+}  // namespace paddock::perception

@@ -1,0 +1,143 @@
+#pragma once
+// ground removal: the slope-robust cascaded ground segmentation of Narksri et
+// al. 2018 ("A Slope-robust Cascaded Ground Segmentation in 3D Point Cloud
+// for Autonomous Vehicles"), the paper's section "Lidar Perception".
+//
+// Stage 1, inter-ring distance, per column (one azimuth, rings ascending).
+// A beam with depression angle d (tan d = -z / r from the optical centre, h =
+// mount_z above the ground) meets a ground plane that rises away from the
+// sensor with slope s at the horizontal range r = h / (tan d + s). Two
+// consecutive returns a (lower beam) and b of one column on such a plane lie
+//   g(a, b) = h (1 / (tan d_b + s) - 1 / (tan d_a + s))
+// apart (infinite when beam b cannot meet the plane). With s = max_slope,
+// the steepest ground we accept, g is the smallest gap ground can produce: a
+// measured gap |r_b - r_a| below g + gap_noise (the range noise's share)
+// means the returns stack up on something steeper than ground. A run of such returns (each one close to the previous)
+// that rises by more than vertical_threshold is a vertical object; its points
+// are non-ground for good. Using each return's own measured direction instead
+// of the nominal ring elevations keeps the test right under a pitched mount.
+//
+// Stage 2, multi-region plane fitting. Around the sensor the plane is cut into
+// `sectors` equal azimuth sectors and concentric rings at region_bounds. Per
+// sector, from the inside out, each region fits z = a x + b y + c (least
+// squares) to its stage-1 ground candidates near the plane of the region
+// inside it (the prior; for the innermost region the ground under the car, z =
+// 0 of the base frame). The fit is iterated fit_iterations times with a window
+// shrinking geometrically from fit_window to ground_threshold, which drops
+// cone returns and other outliers. A region seen by a single ring is an arc:
+// its radial slope is unobservable, so the slope is pulled toward the
+// prior's (a ridge term: the slope error along a direction is weighted by the
+// points' variance there, the prior's by slope_prior_spread^2, or
+// first_slope_prior_spread^2 for the innermost region). A fit steeper than
+// max_slope keeps the prior's slope; a fit off the prior by more than
+// max_step where the regions meet or at its candidates' centroid is
+// discarded for the prior; a region with fewer than min_fit_points
+// candidates takes the prior. A point is ground when it is not vertical and
+// lies less than ground_threshold above its region's plane (below it counts
+// as ground).
+//
+// Every point's height above its region's plane is stored in it; the planes
+// stay queryable (ground_height) for the later stages.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "autonomy/perception/motion_correction.h"
+#include "autonomy/perception/types.h"
+
+namespace paddock::perception {
+
+struct GroundSegmentationParams {
+  // the steepest ground (dz / dr): FS tracks are nearly flat; 0.25 (14 deg)
+  // covers a 10 % slope with 0.1 m bumps on a 10 m wavelength (up to ~0.19)
+  double max_slope = 0.25;  // -, > 0
+  // added to the expected gap: two returns' horizontal ranges differ by
+  // noise too (range noise sigma 2 cm: 2.8 cm on a difference). It matters
+  // for this low sensor, whose upper rings expect only ~4 cm on the steepest
+  // ground, no more than a cone's own slope and noise put between two rings
+  double gap_noise = 0.06;  // m, >= 0
+  // a run of close returns rising by more than this is a vertical object: a
+  // cone at 5 m spans 0.087 m between two 1 deg rings; the ground's range
+  // noise moves near returns by millimetres in height
+  double vertical_threshold = 0.05;  // m, > 0
+  // region boundaries (ascending ranges from the sensor): the ground's rings
+  // of a 0.15 m high sensor lie at 0.5 .. 2.1 m (-16 .. -4 deg), 2.9, 4.3 and
+  // 8.6 m; beyond that only uphill ground returns
+  std::vector<double> region_bounds{2.0, 4.0, 6.0, 9.0, 13.0, 20.0};  // m
+  // azimuth sectors: 32 make a region about 1.7 m wide at 8.6 m, narrow
+  // enough for 0.1 m bumps of a 10 m wavelength
+  int sectors = 32;  // -, >= 1
+  // a point less than this above its region's plane is ground: bumps leave
+  // ~2-3 cm of residual, a cone's lowest returns below this are added back
+  // by the cone reconstruction
+  double ground_threshold = 0.05;  // m, > 0
+  // the first fit takes candidates within this of the prior plane: below
+  // the 0.15 m at which the ring level with the sensor hits every cone
+  double fit_window = 0.1;  // m, >= ground_threshold
+  int fit_iterations = 3;    // -, >= 1
+  // fewer candidates than this: the region takes the prior plane. A ground
+  // ring crosses a 32-sector region in 32 columns; a cone gives a region
+  // 2-10 returns off the vertical runs, so a few cones alone cannot make one
+  int min_fit_points = 20;  // -, >= 3
+  // the ridge pulling an unobservable slope toward the prior's (see the
+  // top). The innermost region's prior is the level ground under the car,
+  // and its returns spread over metres: a weak pull finds a 10 % slope. An
+  // outer region's prior is its inner neighbour's fitted plane, and the
+  // region often holds one ring's arc plus a few cone-base returns whose
+  // leverage would tilt a free fit: a stronger pull
+  double first_slope_prior_spread = 0.1;  // m, > 0
+  double slope_prior_spread = 0.3;        // m, > 0
+  // a fit whose height differs from the prior's by more than this where it
+  // meets the inner region or at its candidates' centroid is discarded
+  double max_step = 0.08;  // m, > 0
+};
+
+// "" when every field is usable, else the first problem, starting with the
+// field name
+std::string validate(const GroundSegmentationParams& p);
+
+struct GroundStats {
+  std::size_t ground = 0;
+  std::size_t non_ground = 0;
+  std::size_t vertical = 0;        // stage 1's vertical points (all non-ground)
+  std::size_t fitted_regions = 0;  // regions with their own plane
+  std::size_t regions = 0;
+};
+
+class GroundSegmenter {
+ public:
+  // throws std::invalid_argument when validate(params) or validate(calibration) fails
+  GroundSegmenter(const GroundSegmentationParams& params, const LidarCalibration& calibration);
+
+  // labels every point Ground or NonGround, sets its height and vertical
+  // flag, and keeps the region planes for ground_height
+  GroundStats segment(Cloud& cloud);
+
+  // the ground's height (base frame z) at (x, y) of the base frame at the
+  // reference time, from the last segment() call's region planes
+  double ground_height(double x, double y) const;
+
+  const GroundSegmentationParams& params() const { return params_; }
+
+ private:
+  struct Plane {
+    double a = 0.0, b = 0.0, c = 0.0;  // z = a x + b y + c
+    double at(double x, double y) const { return a * x + b * y + c; }
+  };
+
+  void inter_ring(Cloud& cloud, GroundStats& stats) const;
+  std::size_t region_of(double x, double y) const;
+  // fits region `region` (its points in members_) from the prior plane
+  Plane fit_region(const Cloud& cloud, std::size_t region, const Plane& prior, double r_inner,
+                   double azimuth, bool& fitted) const;
+
+  GroundSegmentationParams params_;
+  LidarCalibration calib_;
+  std::size_t rings_ = 0;  // concentric regions: region_bounds.size() + 1
+  std::vector<Plane> planes_;  // sector * rings_ + ring
+  // scratch: the points bucketed by region (counting sort)
+  std::vector<std::uint32_t> region_id_, offsets_, cursor_, members_;
+};
+
+}  // namespace paddock::perception

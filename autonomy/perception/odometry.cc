@@ -1,0 +1,103 @@
+#include "autonomy/perception/odometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace paddock::perception {
+
+namespace {
+
+bool finite(double v) { return std::isfinite(v); }
+
+// sin(h) / h, its Taylor series near 0
+double sinc(double h) { return std::abs(h) < 1e-6 ? 1.0 - h * h / 6.0 : std::sin(h) / h; }
+
+}  // namespace
+
+std::string validate(const OdometryParams& p) {
+  std::ostringstream os;
+  if (!finite(p.wheel_radius) || !(p.wheel_radius > 0.0)) {
+    os << "wheel_radius must be finite and > 0 m (got " << p.wheel_radius << ")";
+  } else if (!finite(p.history) || !(p.history > 0.0)) {
+    os << "history must be finite and > 0 s (got " << p.history << ")";
+  } else if (!finite(p.extrapolation) || !(p.extrapolation >= 0.0)) {
+    os << "extrapolation must be finite and >= 0 s (got " << p.extrapolation << ")";
+  }
+  return os.str();
+}
+
+Odometry::Odometry(const OdometryParams& params) : params_(params) {
+  const std::string err = validate(params_);
+  if (!err.empty()) throw std::invalid_argument("OdometryParams: " + err);
+}
+
+void Odometry::add(const hal::Imu& imu) {
+  if (!finite(imu.yaw_rate) || (any_ && imu.stamp < newest_)) {
+    ++rejected_;
+    return;
+  }
+  step(imu.stamp);
+  w_ = imu.yaw_rate;
+  has_w_ = true;
+  if (!knots_.empty() && knots_.back().stamp == imu.stamp) knots_.back().w = w_;
+  if (knots_.empty() && has_v_) knots_.push_back({imu.stamp, Pose2{}, v_, w_});
+}
+
+void Odometry::add(const hal::WheelSpeeds& wheels) {
+  // the rear wheels (RL, RR): unsteered, their mean is the base origin's speed
+  const double rl = wheels.omega[2], rr = wheels.omega[3];
+  if (!finite(rl) || !finite(rr) || (any_ && wheels.stamp < newest_)) {
+    ++rejected_;
+    return;
+  }
+  step(wheels.stamp);
+  v_ = 0.5 * (rl + rr) * params_.wheel_radius;
+  has_v_ = true;
+  if (!knots_.empty() && knots_.back().stamp == wheels.stamp) knots_.back().v = v_;
+  if (knots_.empty() && has_w_) knots_.push_back({wheels.stamp, Pose2{}, v_, w_});
+}
+
+void Odometry::step(TimeNs stamp) {
+  any_ = true;
+  newest_ = stamp;
+  if (knots_.empty()) return;
+  const Knot& last = knots_.back();
+  if (stamp > last.stamp) {
+    // advance with the held values; the caller then stores the new value
+    knots_.push_back({stamp, arc(last, to_seconds(stamp - last.stamp)), v_, w_});
+  }
+  // forget knots older than the history, keeping one at or before its start
+  const TimeNs horizon = stamp - from_seconds(params_.history);
+  while (knots_.size() >= 2 && knots_[1].stamp <= horizon) knots_.pop_front();
+}
+
+Pose2 Odometry::arc(const Knot& k, double dt) {
+  // exact integration at constant v and w: the chord of the arc has length
+  // v dt sinc(w dt / 2) and points along the mean heading yaw + w dt / 2
+  const double dyaw = k.w * dt;
+  const double chord = k.v * dt * sinc(0.5 * dyaw);
+  const double mid = k.pose.yaw + 0.5 * dyaw;
+  return {k.pose.x + chord * std::cos(mid), k.pose.y + chord * std::sin(mid), k.pose.yaw + dyaw};
+}
+
+std::optional<Pose2> Odometry::pose_at(TimeNs t) const {
+  if (knots_.empty()) return std::nullopt;
+  const TimeNs tol = from_seconds(params_.extrapolation);
+  if (t < knots_.front().stamp - tol || t > knots_.back().stamp + tol) return std::nullopt;
+  // the last knot at or before t (the first one when t precedes it)
+  auto it = std::upper_bound(knots_.begin(), knots_.end(), t,
+                             [](TimeNs s, const Knot& k) { return s < k.stamp; });
+  const Knot& k = it == knots_.begin() ? *it : *std::prev(it);
+  return arc(k, to_seconds(t - k.stamp));
+}
+
+std::optional<Pose2> Odometry::relative(TimeNs from, TimeNs to) const {
+  const std::optional<Pose2> a = pose_at(from), b = pose_at(to);
+  if (!a || !b) return std::nullopt;
+  const Vec2 p = a->inverse_transform(b->position());
+  return Pose2{p.x, p.y, wrap_angle(b->yaw - a->yaw)};
+}
+
+}  // namespace paddock::perception

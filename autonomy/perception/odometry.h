@@ -1,0 +1,98 @@
+#pragma once
+// planar dead reckoning of the base frame from the wheel speeds and the IMU's
+// yaw rate, kept over a short history so that the LiDAR pipeline can ask where
+// the base stood at any column's time relative to the scan's reference time
+// (paper section "Lidar Perception": motion correction).
+//
+// Model: the base origin (rear axle centre) moves along its own x axis at the
+// speed v of the rear wheels and turns at the gyro's yaw rate w:
+//   x' = v cos(yaw), y' = v sin(yaw), yaw' = w.
+// v is the mean of the two REAR wheels' speeds times the rolling radius: the
+// rear wheels are not steered, so each rolls along the base's x axis, and at
+// lateral offsets +-track/2 their speeds are v -+ w track/2, whose mean is
+// exactly the base origin's longitudinal speed, whatever the yaw rate (the
+// front wheels are steered and see the lever arm of the wheelbase). The
+// lateral velocity of the rear axle is taken as zero (no side slip there: a
+// kinematic model; a sliding car breaks it and the correction degrades).
+//
+// Each message starts a new interval: between two consecutive message stamps
+// v and w are held at their latest values (zero-order hold) and the motion
+// is integrated exactly (a circular arc, a straight line when w = 0), so a
+// constant speed and yaw rate give the exact arc. A pose between two knots
+// is the arc from the earlier one.
+//
+// No I/O, no clock, no global state.
+#include <cstddef>
+#include <deque>
+#include <optional>
+#include <string>
+
+#include "autonomy/common/geometry.h"
+#include "autonomy/common/time.h"
+#include "autonomy/hal/messages.h"
+
+namespace paddock::perception {
+
+struct OdometryParams {
+  // dynamic rolling radius of the rear wheels: the default vehicle's
+  // (scenarios/vehicles/default.ini, FSSIM r_dyn)
+  double wheel_radius = 0.231;  // m, > 0
+  // how far back the history reaches behind the newest message: a LiDAR
+  // rotation (0.1 s) plus the scan's latency, with room to spare
+  double history = 2.0;  // s, > 0
+  // how far relative() may extrapolate before the first or after the last
+  // message with the held speed and yaw rate: the wheel speeds come every
+  // 10 ms and the IMU every 5 ms, so a scan that ends between two messages
+  // is always covered by 25 ms
+  double extrapolation = 0.025;  // s, >= 0
+};
+
+// "" when every field is usable, else the first problem, starting with the
+// field name
+std::string validate(const OdometryParams& p);
+
+class Odometry {
+ public:
+  // throws std::invalid_argument when validate(params) fails
+  explicit Odometry(const OdometryParams& params = {});
+
+  // a message whose values are not finite, or whose stamp lies before the
+  // newest message seen, is ignored (and counted in rejected())
+  void add(const hal::Imu& imu);
+  void add(const hal::WheelSpeeds& wheels);
+
+  // the pose of the base at `to` expressed in the base frame at `from`;
+  // nullopt when the history (both signals known) does not cover both times
+  // within the extrapolation tolerance
+  std::optional<Pose2> relative(TimeNs from, TimeNs to) const;
+
+  // the dead-reckoned pose at t in the odometry's own frame (its origin: the
+  // pose where both signals were first known); nullopt as for relative()
+  std::optional<Pose2> pose_at(TimeNs t) const;
+
+  std::size_t rejected() const { return rejected_; }
+  const OdometryParams& params() const { return params_; }
+
+ private:
+  // a knot: the pose at `stamp` and the speed and yaw rate held from it on
+  struct Knot {
+    TimeNs stamp = 0;
+    Pose2 pose;
+    double v = 0.0;  // m/s
+    double w = 0.0;  // rad/s
+  };
+
+  // advance to `stamp` with the held values, then hold the new ones
+  void step(TimeNs stamp);
+  static Pose2 arc(const Knot& k, double dt);
+
+  OdometryParams params_;
+  std::deque<Knot> knots_;
+  bool has_v_ = false, has_w_ = false;
+  double v_ = 0.0, w_ = 0.0;
+  TimeNs newest_ = 0;
+  bool any_ = false;
+  std::size_t rejected_ = 0;
+};
+
+}  // namespace paddock::perception

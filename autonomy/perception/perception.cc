@@ -1,0 +1,100 @@
+#include "autonomy/perception/perception.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace paddock::perception {
+
+std::string validate(const PerceptionParams& p) {
+  if (std::string why = validate(p.odometry); !why.empty()) return "odometry." + why;
+  if (std::string why = validate(p.lidar); !why.empty()) return "lidar." + why;
+  if (std::string why = validate(p.detector); !why.empty()) return "detector." + why;
+  if (std::string why = validate(p.fusion); !why.empty()) return "fusion." + why;
+  if (p.use_camera) {
+    const CameraCalibration& c = p.camera;
+    if (c.width <= 0 || c.height <= 0) return "camera: width and height must be > 0";
+    if (!(c.fx > 0.0) || !(c.fy > 0.0)) return "camera: fx and fy must be > 0";
+    if (!std::isfinite(c.cx) || !std::isfinite(c.cy) || !c.T_camera_base.matrix().allFinite())
+      return "camera: cx, cy and T_camera_base must be finite";
+  }
+  if (!(p.camera_sync_tolerance >= 0.0)) return "camera_sync_tolerance must be >= 0";
+  return "";
+}
+
+namespace {
+const PerceptionParams& checked(const PerceptionParams& p) {
+  if (std::string why = validate(p); !why.empty()) throw std::invalid_argument("PerceptionParams: " + why);
+  return p;
+}
+}  // namespace
+
+Perception::Perception(const PerceptionParams& params, std::uint64_t seed)
+    : params_(checked(params)), odometry_(params.odometry), pipeline_(params.lidar) {
+  if (params_.use_camera) detector_ = std::make_unique<AnnotationDetector>(params_.detector, seed);
+}
+
+void Perception::add(hal::CameraFrame frame) { frame_ = std::move(frame); }
+
+const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
+  ++stats_.scans;
+  last_.lidar = pipeline_.process(scan, &odometry_);
+  last_.camera_used = false;
+  last_.camera_note.clear();
+  last_.detection = {};
+  last_.fusion = {};
+  hal::ConeDetections& out = last_.output;
+  out.stamp = last_.lidar.stamp;
+  out.cones.clear();
+  if (!last_.lidar.ok) {
+    ++stats_.scans_failed;
+    return out;
+  }
+  if (!last_.lidar.corrected) ++stats_.scans_uncorrected;
+  const std::vector<ConeCandidate>& cands = last_.lidar.cones;
+
+  // the camera frame exposed during this rotation, if the mode has a camera
+  const TimeNs tol = from_seconds(params_.camera_sync_tolerance);
+  if (params_.use_camera) {
+    if (!frame_) {
+      last_.camera_note = "no camera frame";
+    } else if (frame_->stamp < scan.stamp - tol || frame_->stamp > scan.end + tol) {
+      last_.camera_note = "no camera frame of this rotation";
+    } else {
+      last_.detection = detector_->detect(*frame_);
+      if (!last_.detection.ok) last_.camera_note = "detector: " + last_.detection.reason;
+    }
+  }
+  if (!params_.use_camera || !last_.detection.ok) {
+    if (params_.use_camera) ++stats_.scans_without_camera;
+    for (const ConeCandidate& c : cands) out.cones.push_back({{c.centre.x(), c.centre.y()}, c.color});
+    return out;
+  }
+
+  // the candidates at the camera's exposure: the base pose at the scan's
+  // reference time seen from the base at the exposure (planar motion)
+  last_.camera_used = true;
+  last_.camera_stamp = frame_->stamp;
+  std::vector<ConeCandidate> at_camera = cands;
+  if (const std::optional<Pose2> rel = odometry_.relative(frame_->stamp, out.stamp)) {
+    for (ConeCandidate& c : at_camera) {
+      const Vec2 p = rel->transform({c.centre.x(), c.centre.y()});
+      c.centre.x() = p.x;
+      c.centre.y() = p.y;
+    }
+  } else {
+    last_.camera_note = "no odometry between the exposure and the scan: fused unmoved";
+  }
+  last_.fusion = fuse(at_camera, last_.detection.boxes, params_.camera, params_.fusion);
+  for (std::size_t i = 0; i < cands.size(); ++i) {
+    const FusedCone& f = last_.fusion.cones[i];
+    if (!f.kept) {
+      ++stats_.dropped_by_fusion;
+      continue;
+    }
+    out.cones.push_back({{cands[i].centre.x(), cands[i].centre.y()}, f.color});
+  }
+  return out;
+}
+
+}  // namespace paddock::perception

@@ -1,0 +1,99 @@
+#pragma once
+// the perception front of the stack (the paper's section "Perception"): raw
+// LiDAR scans and camera frames in, cone detections out.
+//
+//   odometry  IMU yaw rate + wheel speeds, dead-reckoned over the last seconds
+//   LiDAR     motion correction -> ground removal -> clustering ->
+//             reconstruction -> rule filters -> intensity colour
+//             (LidarPipeline): cone candidates in the base frame at the end of
+//             the rotation
+//   camera    the detector's boxes on the frame the LiDAR triggered during
+//             that rotation (ConeDetector; the AnnotationDetector here)
+//   fusion    each candidate moved by the odometry to the base frame at the
+//             camera's exposure, projected through K [R|T]: in a box -> the
+//             box's colour, in view but in no box -> dropped, out of view ->
+//             the LiDAR's colour (fuse)
+//
+// use_camera = false is the LiDAR-only mode (perception = lidar). A missing or
+// unusable camera frame degrades a lidar_camera scan to LiDAR only for that
+// scan (counted in the stats), it never stops the output.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "autonomy/hal/messages.h"
+#include "autonomy/perception/detector.h"
+#include "autonomy/perception/fusion.h"
+#include "autonomy/perception/lidar_pipeline.h"
+#include "autonomy/perception/odometry.h"
+#include "autonomy/perception/types.h"
+
+namespace paddock::perception {
+
+struct PerceptionParams {
+  bool use_camera = true;
+  OdometryParams odometry;
+  LidarPipelineParams lidar;  // its calibration: the LiDAR's mounting and beams
+  CameraCalibration camera;   // K and T_camera_base
+  DetectorParams detector;
+  FusionParams fusion;
+  // a camera frame serves the scan during whose rotation it was exposed, give
+  // or take this much (s)
+  double camera_sync_tolerance = 0.02;
+};
+
+// "" when every field is usable, else the first problem ("lidar.…", "camera.…")
+std::string validate(const PerceptionParams& p);
+
+// what the last scan went through, for plots and diagnostics
+struct PerceptionFrame {
+  LidarResult lidar;
+  bool camera_used = false;            // the scan was fused with a camera frame
+  std::string camera_note;             // why not, when the mode has a camera
+  TimeNs camera_stamp = 0;
+  DetectorResult detection;            // the camera frame's boxes (camera_used)
+  FusionResult fusion;                 // per LiDAR candidate (camera_used)
+  hal::ConeDetections output;
+};
+
+struct PerceptionStats {
+  long scans = 0;
+  long scans_uncorrected = 0;     // no odometry over the rotation
+  long scans_failed = 0;          // the LiDAR pipeline returned no usable result
+  long scans_without_camera = 0;  // lidar_camera scans that fell back to LiDAR only
+  long dropped_by_fusion = 0;     // candidates dropped as false detections
+};
+
+class Perception {
+ public:
+  // throws std::invalid_argument when validate(params) fails; the seed starts
+  // the detector's random stream
+  Perception(const PerceptionParams& params, std::uint64_t seed);
+
+  void add(const hal::Imu& imu) { odometry_.add(imu); }
+  void add(const hal::WheelSpeeds& wheels) { odometry_.add(wheels); }
+  // the newest camera frame is kept until a scan uses it
+  void add(hal::CameraFrame frame);
+
+  // one rotation -> the cones, base frame at the scan's reference time (its end)
+  const hal::ConeDetections& process(const hal::LidarScan& scan);
+
+  // keep the labelled points of the next scans (for plots)
+  void set_keep_points(bool keep) { params_.lidar.keep_points = keep; pipeline_ = LidarPipeline(params_.lidar); }
+  const PerceptionFrame& last() const { return last_; }
+  const PerceptionStats& stats() const { return stats_; }
+  // the newest camera frame received (for plots), if any
+  const std::optional<hal::CameraFrame>& camera_frame() const { return frame_; }
+
+ private:
+  PerceptionParams params_;
+  Odometry odometry_;
+  LidarPipeline pipeline_;
+  std::unique_ptr<ConeDetector> detector_;
+  std::optional<hal::CameraFrame> frame_;
+  PerceptionFrame last_;
+  PerceptionStats stats_;
+};
+
+}  // namespace paddock::perception

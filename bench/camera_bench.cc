@@ -1,0 +1,161 @@
+// the camera path of the perception pipeline on the FSG 2023 trackdrive
+// (tracks/fsg_2023.csv, its cones on a flat ground, default parameters):
+//   BM_CameraFrame   one rendered frame (Camera::render into a reused frame,
+//                    800 x 500), from 50 poses spread along the centreline,
+//                    looking along it, one pose per iteration in turn;
+//                    target: well under 5 ms on one core (10 Hz camera, the
+//                    whole closed loop >= 20x real time)
+//   BM_CameraFrameBumpy  the same on a bumpy ground (height field: the boxes'
+//                    pixels plus a ray per 4 x 4 tile)
+//   BM_CameraFrameNoisy  the same with 2 levels of pixel noise
+//   BM_Detector      AnnotationDetector::detect on such a frame (a pass over
+//                    the labels, the error model)
+//   BM_Fusion        fuse() of 60 candidates (the cones within 20 m ahead and
+//                    a few fakes) with that frame's boxes
+// Counters: mean and p99 (ms) of the timed calls, rays cast, instances.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "autonomy/perception/detector.h"
+#include "autonomy/perception/fusion.h"
+#include "sim/sensors/camera.h"
+#include "sim/world/track.h"
+
+namespace {
+
+using namespace paddock;
+
+world::TrackModel fsg_2023() {
+  const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/tracks/fsg_2023.csv";
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return world::build_track(world::parse_track(text.str(), path));
+}
+
+// n base poses along the centreline, each looking at the point 2 m ahead
+std::vector<Pose2> poses_along(const world::TrackModel& t, int n) {
+  std::vector<Pose2> poses;
+  const std::size_t m = t.centreline.size();
+  for (int k = 0; k < n; ++k) {
+    const std::size_t i = m * static_cast<std::size_t>(k) / static_cast<std::size_t>(n);
+    const Vec2 a = t.centreline[i], b = t.centreline[(i + 4) % m];
+    poses.push_back({a.x, a.y, angle_of(b - a)});
+  }
+  return poses;
+}
+
+void report(benchmark::State& state, std::vector<double>& ms) {
+  std::sort(ms.begin(), ms.end());
+  double sum = 0.0;
+  for (double v : ms) sum += v;
+  const std::size_t i99 = std::min(ms.size() - 1, static_cast<std::size_t>(0.99 * static_cast<double>(ms.size())));
+  state.counters["mean_ms"] = sum / static_cast<double>(ms.size());
+  state.counters["p99_ms"] = ms[i99];
+}
+
+void camera_frames(benchmark::State& state, const sensors::GroundParams& ground,
+                   const sensors::CameraParams& params = {}) {
+  const world::TrackModel track = fsg_2023();
+  const sensors::LidarWorld world(track.cones, {}, ground);
+  sensors::Camera camera(params, 1);
+  const std::vector<Pose2> poses = poses_along(track, 50);
+  hal::CameraFrame frame;
+  std::vector<double> ms;
+  std::size_t k = 0, rays = 0, instances = 0;
+  for (auto _ : state) {
+    const Pose2& pose = poses[k++ % poses.size()];
+    const auto t0 = std::chrono::steady_clock::now();
+    camera.render(world, pose, 0, frame);
+    const auto t1 = std::chrono::steady_clock::now();
+    ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    rays += camera.last_primary_rays() + camera.last_continued_rays();
+    instances += frame.instances.size();
+    benchmark::DoNotOptimize(frame.rgb.data());
+  }
+  report(state, ms);
+  state.counters["cones"] = static_cast<double>(track.cones.size());
+  state.counters["rays"] = static_cast<double>(rays) / static_cast<double>(ms.size());
+  state.counters["instances"] = static_cast<double>(instances) / static_cast<double>(ms.size());
+}
+
+void BM_CameraFrame(benchmark::State& state) { camera_frames(state, {}); }
+BENCHMARK(BM_CameraFrame)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+void BM_CameraFrameBumpy(benchmark::State& state) {
+  sensors::GroundParams g;
+  g.bump_height = 0.1;
+  g.bump_wavelength = 10.0;
+  camera_frames(state, g);
+}
+BENCHMARK(BM_CameraFrameBumpy)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+void BM_CameraFrameNoisy(benchmark::State& state) {
+  sensors::CameraParams p;
+  p.pixel_noise = 2.0;
+  camera_frames(state, {}, p);
+}
+BENCHMARK(BM_CameraFrameNoisy)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+// a frame from the start pose of the track, for the detector and the fusion
+struct Scene {
+  world::TrackModel track = fsg_2023();
+  hal::CameraFrame frame;
+  perception::CameraCalibration calib;
+  Pose2 pose;
+};
+
+Scene start_scene() {
+  Scene s;
+  const sensors::LidarWorld world(s.track.cones);
+  sensors::Camera camera(sensors::CameraParams{}, 1);
+  s.pose = poses_along(s.track, 50)[3];
+  s.frame = camera.render(world, s.pose, 0);
+  s.calib = camera.calibration();
+  return s;
+}
+
+void BM_Detector(benchmark::State& state) {
+  const Scene s = start_scene();
+  perception::AnnotationDetector detector(perception::DetectorParams{}, 1);
+  std::size_t boxes = 0;
+  for (auto _ : state) {
+    const perception::DetectorResult r = detector.detect(s.frame);
+    boxes = r.boxes.size();
+    benchmark::DoNotOptimize(r.boxes.data());
+  }
+  state.counters["instances"] = static_cast<double>(s.frame.instances.size());
+  state.counters["boxes"] = static_cast<double>(boxes);
+}
+BENCHMARK(BM_Detector)->Unit(benchmark::kMicrosecond);
+
+void BM_Fusion(benchmark::State& state) {
+  const Scene s = start_scene();
+  perception::AnnotationDetector detector(perception::DetectorParams{}, 1);
+  const perception::DetectorResult det = detector.detect(s.frame);
+  // the cones within 20 m (base frame, mid-height), then fakes between them
+  std::vector<perception::ConeCandidate> cands;
+  for (const Cone& c : s.track.cones) {
+    const Vec2 b = s.pose.inverse_transform(c.position);
+    if (norm(b) < 20.0 && cands.size() < 50) cands.push_back({Eigen::Vector3d(b.x, b.y, 0.16), c.color, 20});
+  }
+  for (int k = 0; cands.size() < 60; ++k) cands.push_back({Eigen::Vector3d(3.0 + k, 0.0, 0.16), ConeColor::Unknown, 10});
+  int kept = 0;
+  for (auto _ : state) {
+    const perception::FusionResult r = perception::fuse(cands, det.boxes, s.calib);
+    kept = r.from_camera + r.from_lidar;
+    benchmark::DoNotOptimize(r.cones.data());
+  }
+  state.counters["candidates"] = static_cast<double>(cands.size());
+  state.counters["boxes"] = static_cast<double>(det.boxes.size());
+  state.counters["kept"] = kept;
+}
+BENCHMARK(BM_Fusion)->Unit(benchmark::kMicrosecond);
+
+}  // namespace

@@ -1,0 +1,571 @@
+#include "sim/sensors/camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+#include "sim/sensors/param_check.h"
+
+namespace paddock::sensors {
+
+namespace {
+
+bool finite(double v) { return std::isfinite(v); }
+
+std::uint8_t to_byte(double v) {
+  return static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(v, 0.0, 1.0)));
+}
+
+bool unit_rgb(const Rgb& c) {
+  const auto in = [](double v) { return finite(v) && v >= 0.0 && v <= 1.0; };
+  return in(c.r) && in(c.g) && in(c.b);
+}
+
+const Rgb& albedo(const CameraParams& p, LidarMaterial m) {
+  switch (m) {
+    case LidarMaterial::White: return p.white;
+    case LidarMaterial::Yellow: return p.yellow;
+    case LidarMaterial::Orange: return p.orange;
+    case LidarMaterial::Blue: return p.blue;
+    case LidarMaterial::Black: return p.black;
+    case LidarMaterial::Grey: return p.grey;
+    case LidarMaterial::Ground: return p.ground;
+  }
+  return p.grey;
+}
+
+// splitmix64: a small, fast, seedable stream for the per-channel pixel noise
+std::uint64_t splitmix(std::uint64_t& s) {
+  std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+constexpr float kNear = 1e-3f;          // m, near plane for the boxes' projection
+constexpr double kCarryStep = 1e-4;     // m, past a hit before casting on
+constexpr int kMaxCarry = 64;           // surfaces a carried-on ray may pass
+constexpr std::uint8_t kMaxCover = 255;
+constexpr int kGroundTile = 4;          // px, non-flat ground outside the boxes
+
+}  // namespace
+
+std::string validate(const CameraParams& p) {
+  std::string e;
+  const double deg = kPi / 180.0;
+  if (p.width < 16 || p.width > 8192) {
+    std::ostringstream os;
+    os << "width must be in [16, 8192] px (got " << p.width << ")";
+    return os.str();
+  }
+  if (p.height < 16 || p.height > 8192) {
+    std::ostringstream os;
+    os << "height must be in [16, 8192] px (got " << p.height << ")";
+    return os.str();
+  }
+  if (!(e = check_range("hfov", p.hfov, 10.0 * deg, 170.0 * deg, "rad")).empty()) return e;
+  if (!(e = check_range("mount_x", p.mount_x, -kNoUpperBound, kNoUpperBound, "m")).empty()) return e;
+  if (!(e = check_range("mount_y", p.mount_y, -kNoUpperBound, kNoUpperBound, "m")).empty()) return e;
+  if (!finite(p.mount_z) || !(p.mount_z > 0.0)) {
+    std::ostringstream os;
+    os << "mount_z must be finite and > 0 m (got " << p.mount_z << ")";
+    return os.str();
+  }
+  if (!finite(p.mount_pitch) || !(std::abs(p.mount_pitch) < 0.5 * kPi)) {
+    std::ostringstream os;
+    os << "mount_pitch must be in (-pi/2, pi/2) rad (got " << p.mount_pitch << ")";
+    return os.str();
+  }
+  if (!(e = check_range("trigger_azimuth", p.trigger_azimuth, -kPi, kPi, "rad")).empty()) return e;
+  if (!(e = check_range("sun_azimuth", p.sun_azimuth, -2.0 * kPi, 2.0 * kPi, "rad")).empty()) return e;
+  if (!(e = check_range("sun_elevation", p.sun_elevation, 0.0, 0.5 * kPi, "rad")).empty()) return e;
+  if (!(e = check_range("ambient", p.ambient, 0.0, 1.0, "")).empty()) return e;
+  const std::pair<const char*, const Rgb*> colours[] = {
+      {"sky", &p.sky},       {"ground", &p.ground}, {"blue", &p.blue},   {"yellow", &p.yellow},
+      {"orange", &p.orange}, {"white", &p.white},   {"black", &p.black}, {"grey", &p.grey}};
+  for (const auto& [name, c] : colours) {
+    if (!unit_rgb(*c)) return std::string(name) + " must have r, g, b finite in [0, 1]";
+  }
+  return check_range("pixel_noise", p.pixel_noise, 0.0, 64.0, "levels");
+}
+
+int trigger_column(const LidarParams& lidar, double azimuth) {
+  const int n = std::max(lidar.columns, 1);
+  const double a = wrap_angle(azimuth);  // [-pi, pi)
+  const long c = std::lround((a + kPi) * n / (2.0 * kPi));
+  return static_cast<int>(((c % n) + n) % n);
+}
+
+TimeNs trigger_time(const LidarParams& lidar, double azimuth, TimeNs scan_start) {
+  const TimeNs period = from_seconds(1.0 / lidar.rate);
+  return scan_start + period * trigger_column(lidar, azimuth) / std::max(lidar.columns, 1);
+}
+
+perception::CameraCalibration camera_calibration(const CameraParams& p) {
+  perception::CameraCalibration c;
+  c.width = p.width;
+  c.height = p.height;
+  c.fx = c.fy = 0.5 * p.width / std::tan(0.5 * p.hfov);
+  c.cx = 0.5 * p.width;
+  c.cy = 0.5 * p.height;
+  // the optical axes in the base frame: x right = -y_base; y down and z
+  // forward are -z_base and +x_base pitched nose down by mount_pitch about y_base
+  // (R_y(theta) takes x_base to (cos, 0, -sin))
+  const double ct = std::cos(p.mount_pitch), st = std::sin(p.mount_pitch);
+  Eigen::Matrix3d R_base_camera;
+  R_base_camera.col(0) = Eigen::Vector3d(0.0, -1.0, 0.0);
+  R_base_camera.col(1) = Eigen::Vector3d(-st, 0.0, -ct);
+  R_base_camera.col(2) = Eigen::Vector3d(ct, 0.0, -st);
+  Eigen::Isometry3d T_base_camera = Eigen::Isometry3d::Identity();
+  T_base_camera.linear() = R_base_camera;
+  T_base_camera.translation() = Eigen::Vector3d(p.mount_x, p.mount_y, p.mount_z);
+  c.T_camera_base = T_base_camera.inverse();
+  return c;
+}
+
+Camera::Camera(const CameraParams& params, std::uint64_t seed)
+    : params_(params), rng_(seed) {
+  const std::string err = validate(params_);
+  if (!err.empty()) throw std::invalid_argument("CameraParams: " + err);
+  calibration_ = camera_calibration(params_);
+  const auto w = static_cast<std::size_t>(params_.width);
+  const auto h = static_cast<std::size_t>(params_.height);
+  ax_.resize(w);
+  by_.resize(h);
+  for (std::size_t i = 0; i < w; ++i) {
+    ax_[i] = (static_cast<double>(i) + 0.5 - calibration_.cx) / calibration_.fx;
+  }
+  for (std::size_t j = 0; j < h; ++j) {
+    by_[j] = (static_cast<double>(j) + 0.5 - calibration_.cy) / calibration_.fy;
+  }
+  const double ce = std::cos(params_.sun_elevation);
+  sun_[0] = ce * std::cos(params_.sun_azimuth);
+  sun_[1] = ce * std::sin(params_.sun_azimuth);
+  sun_[2] = std::sin(params_.sun_elevation);
+  sky_rgb_ = {to_byte(params_.sky.r), to_byte(params_.sky.g), to_byte(params_.sky.b)};
+  ground_rgb_ = shade(params_.ground, std::max(0.0, sun_[2]));
+  stamp_.assign(w * h, 0);
+  cover_.assign(w * h, 0);
+  reach_.assign(w * h, 0.0f);
+  // the noise table: the quantiles Phi^-1((k + 0.5) / 4096) (bisection on
+  // Phi(z) = erfc(-z / sqrt 2) / 2), times pixel_noise, rounded to levels
+  if (params_.pixel_noise > 0.0) {
+    noise_.resize(4096);
+    for (std::size_t k = 0; k < noise_.size(); ++k) {
+      const double q = (static_cast<double>(k) + 0.5) / static_cast<double>(noise_.size());
+      double lo = -8.0, hi = 8.0;
+      for (int it = 0; it < 48; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (0.5 * std::erfc(-mid / std::sqrt(2.0)) < q ? lo : hi) = mid;
+      }
+      noise_[k] = static_cast<std::int16_t>(std::lround(params_.pixel_noise * 0.5 * (lo + hi)));
+    }
+  }
+}
+
+std::array<std::uint8_t, 3> Camera::shade(const Rgb& a, double lambert) const {
+  const double k = params_.ambient + (1.0 - params_.ambient) * lambert;
+  return {to_byte(a.r * k), to_byte(a.g * k), to_byte(a.b * k)};
+}
+
+void Camera::read_cones(const LidarWorld& world) {
+  cones_.clear();
+  cone_geom_id_ = RTC_INVALID_GEOMETRY_ID;
+  geom_of_.assign(world.cone_count(), -1);
+  // the cone geometry: the one whose primitive 0 belongs to a cone (LidarWorld
+  // attaches the ground, then the cones)
+  for (unsigned g = 0; g < 4; ++g) {
+    if (world.cone_of(g, 0) >= 0) {
+      cone_geom_id_ = g;
+      break;
+    }
+  }
+  if (cone_geom_id_ == RTC_INVALID_GEOMETRY_ID) return;
+  RTCGeometry geom = rtcGetGeometryThreadSafe(world.scene(), cone_geom_id_);
+  if (geom == nullptr) return;
+  const auto* v = static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+  const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+  if (v == nullptr || idx == nullptr) return;
+  // every triangle grows the box of its cone; a cone's triangles are contiguous
+  std::int32_t prev = -1;
+  ConeGeom* cur = nullptr;
+  for (unsigned prim = 0;; ++prim) {
+    const std::int32_t c = world.cone_of(cone_geom_id_, prim);
+    if (c < 0) break;
+    if (c != prev) {
+      const auto cu = static_cast<std::size_t>(c);
+      if (geom_of_[cu] < 0) {
+        geom_of_[cu] = static_cast<std::int32_t>(cones_.size());
+        ConeGeom cg;
+        cg.id = c;
+        cg.prim = prim;
+        const float* p = v + 3 * idx[3 * prim];
+        std::copy(p, p + 3, cg.lo);
+        std::copy(p, p + 3, cg.hi);
+        cones_.push_back(cg);
+      }
+      cur = &cones_[static_cast<std::size_t>(geom_of_[cu])];
+      prev = c;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const float* p = v + 3 * idx[3 * prim + static_cast<unsigned>(k)];
+      for (int a = 0; a < 3; ++a) {
+        cur->lo[a] = std::min(cur->lo[a], p[a]);
+        cur->hi[a] = std::max(cur->hi[a], p[a]);
+      }
+    }
+  }
+}
+
+ConeColor Camera::cone_class(const LidarWorld& world, const ConeGeom& c, double mid[3]) const {
+  // lidar.h: a standing cone's axis is world +z from its base centre, a knocked
+  // cone's world +x (base at -x); standing cones are taller than wide, knocked
+  // ones longer along x than high
+  const double ex = c.hi[0] - c.lo[0], ez = c.hi[2] - c.lo[2];
+  const bool standing = ez > ex;
+  const double base[3] = {standing ? 0.5 * (c.lo[0] + c.hi[0]) : c.lo[0], 0.5 * (c.lo[1] + c.hi[1]),
+                          standing ? c.lo[2] : 0.5 * (c.lo[2] + c.hi[2])};
+  const double axis[3] = {standing ? 0.0 : 1.0, 0.0, standing ? 1.0 : 0.0};
+  const double h = standing ? ez : ex;
+  for (int a = 0; a < 3; ++a) mid[a] = base[a] + 0.5 * h * axis[a];
+  // the body's material 10 % up the axis (below every stripe), the size from the height
+  const LidarMaterial m = world.material_of(cone_geom_id_, c.prim, base[0] + 0.1 * h * axis[0],
+                                            base[1], base[2] + 0.1 * h * axis[2]);
+  switch (m) {
+    case LidarMaterial::Blue: return ConeColor::Blue;
+    case LidarMaterial::Yellow: return ConeColor::Yellow;
+    case LidarMaterial::Orange:
+      return h > 0.5 * (kSmallConeHeight + kBigConeHeight) ? ConeColor::BigOrange : ConeColor::SmallOrange;
+    default: return ConeColor::Unknown;
+  }
+}
+
+hal::CameraFrame Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp) {
+  hal::CameraFrame f;
+  render(world, base_pose, stamp, f);
+  return f;
+}
+
+void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp, hal::CameraFrame& out) {
+  const int W = params_.width, H = params_.height;
+  const std::size_t n_px = static_cast<std::size_t>(W) * static_cast<std::size_t>(H);
+  out.stamp = stamp;
+  out.width = W;
+  out.height = H;
+  out.rgb.resize(3 * n_px);
+  out.labels.assign(n_px, -1);
+  out.instances.clear();
+  last_primary_rays_ = last_continued_rays_ = 0;
+  if (!finite(base_pose.x) || !finite(base_pose.y) || !finite(base_pose.yaw)) {
+    std::fill(out.rgb.begin(), out.rgb.end(), std::uint8_t{0});
+    return;
+  }
+  // a new stamp for "inside a box this frame"; on wrap-around, clear the stamps
+  if (++frame_ == 0) {
+    std::fill(stamp_.begin(), stamp_.end(), 0u);
+    frame_ = 1;
+  }
+
+  // the optical centre and axes in the world: the base's yaw on top of the mount
+  const Vec2 o2 = base_pose.transform({params_.mount_x, params_.mount_y});
+  const double o[3] = {o2.x, o2.y, world.ground_z(o2.x, o2.y) + params_.mount_z};
+  const Eigen::Matrix3d Rbc = calibration_.T_camera_base.linear().transpose();
+  const double cyaw = std::cos(base_pose.yaw), syaw = std::sin(base_pose.yaw);
+  double col[3][3];  // col[k]: optical axis k in the world
+  for (int k = 0; k < 3; ++k) {
+    const double bx = Rbc(0, k), by = Rbc(1, k), bz = Rbc(2, k);
+    col[k][0] = cyaw * bx - syaw * by;
+    col[k][1] = syaw * bx + cyaw * by;
+    col[k][2] = bz;
+  }
+  const bool flat_ground = flat(world.ground());
+
+  // background, row by row: with no roll the x axis is level, so a row's rays
+  // all point up (sky) or all down (flat ground)
+  for (int j = 0; j < H; ++j) {
+    const double dz = by_[static_cast<std::size_t>(j)] * col[1][2] + col[2][2];
+    const std::array<std::uint8_t, 3>& c = (flat_ground && dz < 0.0) ? ground_rgb_ : sky_rgb_;
+    std::uint8_t* row = out.rgb.data() + 3 * static_cast<std::size_t>(j) * static_cast<std::size_t>(W);
+    for (int i = 0; i < W; ++i) {
+      row[3 * i] = c[0];
+      row[3 * i + 1] = c[1];
+      row[3 * i + 2] = c[2];
+    }
+  }
+
+  // the cones' boxes: project each cone's 3D box (clipped at the near plane),
+  // mark the pixels whose centres it may cover (plus 1 px)
+  read_cones(world);
+  visible_.assign(world.cone_count(), 0);
+  unoccluded_.assign(world.cone_count(), 0);
+  boxed_.clear();
+  cast_.clear();
+  for (std::size_t s = 0; s < cones_.size(); ++s) {
+    const ConeGeom& c = cones_[s];
+    float pc[8][3];
+    for (int k = 0; k < 8; ++k) {
+      const double w[3] = {(k & 1) ? c.hi[0] : c.lo[0], (k & 2) ? c.hi[1] : c.lo[1], (k & 4) ? c.hi[2] : c.lo[2]};
+      const double d[3] = {w[0] - o[0], w[1] - o[1], w[2] - o[2]};
+      for (int a = 0; a < 3; ++a) {
+        pc[k][a] = static_cast<float>(col[a][0] * d[0] + col[a][1] * d[1] + col[a][2] * d[2]);
+      }
+    }
+    float u0 = 1e30f, u1 = -1e30f, v0 = 1e30f, v1 = -1e30f;
+    bool any = false;
+    float reach = 0.0f;  // m, to the box's farthest corner
+    for (int k = 0; k < 8; ++k) {
+      reach = std::max(reach, std::sqrt(pc[k][0] * pc[k][0] + pc[k][1] * pc[k][1] + pc[k][2] * pc[k][2]));
+    }
+    const auto add = [&](float x, float y, float z) {
+      const float u = static_cast<float>(calibration_.fx) * x / z + static_cast<float>(calibration_.cx);
+      const float v = static_cast<float>(calibration_.fy) * y / z + static_cast<float>(calibration_.cy);
+      u0 = std::min(u0, u);
+      u1 = std::max(u1, u);
+      v0 = std::min(v0, v);
+      v1 = std::max(v1, v);
+      any = true;
+    };
+    for (int k = 0; k < 8; ++k) {
+      if (pc[k][2] >= kNear) add(pc[k][0], pc[k][1], pc[k][2]);
+      // the box's edges (corners one bit apart) that cross the near plane
+      for (int b = 1; b < 8; b <<= 1) {
+        const int m = k | b;
+        if (m == k) continue;
+        const float za = pc[k][2], zb = pc[m][2];
+        if ((za < kNear) == (zb < kNear)) continue;
+        const float t = (kNear - za) / (zb - za);
+        add(pc[k][0] + t * (pc[m][0] - pc[k][0]), pc[k][1] + t * (pc[m][1] - pc[k][1]), kNear);
+      }
+    }
+    if (!any) continue;
+    // pixel i's centre i + 0.5 lies in [u0, u1] for i in [u0 - 0.5, u1 - 0.5]; +-1 px
+    const float lim_u = static_cast<float>(W), lim_v = static_cast<float>(H);
+    if (u1 < -1.0f || v1 < -1.0f || u0 > lim_u + 1.0f || v0 > lim_v + 1.0f) continue;
+    const int i0 = std::max(0, static_cast<int>(std::ceil(std::max(u0, -2.0f) - 0.5f)) - 1);
+    const int i1 = std::min(W - 1, static_cast<int>(std::floor(std::min(u1, lim_u + 2.0f) - 0.5f)) + 1);
+    const int j0 = std::max(0, static_cast<int>(std::ceil(std::max(v0, -2.0f) - 0.5f)) - 1);
+    const int j1 = std::min(H - 1, static_cast<int>(std::floor(std::min(v1, lim_v + 2.0f) - 0.5f)) + 1);
+    if (i0 > i1 || j0 > j1) continue;
+    boxed_.push_back(static_cast<std::int32_t>(s));
+    for (int j = j0; j <= j1; ++j) {
+      const std::size_t row = static_cast<std::size_t>(j) * static_cast<std::size_t>(W);
+      for (int i = i0; i <= i1; ++i) {
+        const std::size_t p = row + static_cast<std::size_t>(i);
+        if (stamp_[p] != frame_) {
+          stamp_[p] = frame_;
+          cover_[p] = 1;
+          reach_[p] = reach;
+          cast_.push_back(static_cast<std::uint32_t>(p));
+        } else {
+          if (cover_[p] < kMaxCover) ++cover_[p];
+          reach_[p] = std::max(reach_[p], reach);
+        }
+      }
+    }
+  }
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  const auto o_x = static_cast<float>(o[0]), o_y = static_cast<float>(o[1]), o_z = static_cast<float>(o[2]);
+  // the unit ray through the centre of pixel p
+  const auto ray_dir = [&](std::uint32_t p, double d[3]) {
+    const double a = ax_[p % static_cast<std::uint32_t>(W)], c = by_[p / static_cast<std::uint32_t>(W)];
+    for (int e = 0; e < 3; ++e) d[e] = a * col[0][e] + c * col[1][e] + col[2][e];
+    const double inv = 1.0 / std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int e = 0; e < 3; ++e) d[e] *= inv;
+  };
+  // cast the pixels of `list` in packets of 16 (neighbours in a row: coherent)
+  // and hand each hit to on_hit(pixel, rayhit, lane)
+  const auto cast = [&](const std::vector<std::uint32_t>& list, auto&& on_hit) {
+    for (std::size_t b = 0; b < list.size(); b += 16) {
+      const int n = static_cast<int>(std::min<std::size_t>(16, list.size() - b));
+      alignas(64) int valid[16];
+      alignas(64) RTCRayHit16 rh;
+      for (int k = 0; k < 16; ++k) {
+        valid[k] = k < n ? -1 : 0;
+        double d[3];
+        ray_dir(list[b + static_cast<std::size_t>(std::min(k, n - 1))], d);
+        rh.ray.org_x[k] = o_x;
+        rh.ray.org_y[k] = o_y;
+        rh.ray.org_z[k] = o_z;
+        rh.ray.dir_x[k] = static_cast<float>(d[0]);
+        rh.ray.dir_y[k] = static_cast<float>(d[1]);
+        rh.ray.dir_z[k] = static_cast<float>(d[2]);
+        rh.ray.tnear[k] = 0.0f;
+        rh.ray.tfar[k] = std::numeric_limits<float>::infinity();
+        rh.ray.time[k] = 0.0f;
+        rh.ray.mask[k] = 0xFFFFFFFFu;
+        rh.ray.id[k] = static_cast<unsigned>(k);
+        rh.ray.flags[k] = 0;
+        rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect16(valid, world.scene(), &context, &rh);
+      last_primary_rays_ += static_cast<std::size_t>(n);
+      for (int k = 0; k < n; ++k) {
+        if (rh.hit.geomID[k] == RTC_INVALID_GEOMETRY_ID) continue;  // sky: already filled
+        on_hit(list[b + static_cast<std::size_t>(k)], rh, k);
+      }
+    }
+  };
+  // the Lambert term of hit k: the facet's normal turned towards the camera
+  const auto lambert_of = [&](const RTCRayHit16& rh, int k) {
+    const double nx = rh.hit.Ng_x[k], ny = rh.hit.Ng_y[k], nz = rh.hit.Ng_z[k];
+    const double nn = std::sqrt(nx * nx + ny * ny + nz * nz);
+    if (!(nn > 0.0)) return 0.0;
+    const double facing = nx * rh.ray.dir_x[k] + ny * rh.ray.dir_y[k] + nz * rh.ray.dir_z[k];
+    const double sgn = facing > 0.0 ? -1.0 / nn : 1.0 / nn;
+    return std::max(0.0, sgn * (nx * sun_[0] + ny * sun_[1] + nz * sun_[2]));
+  };
+
+  // non-flat ground outside the boxes: one ray a kGroundTile x kGroundTile
+  // tile (through its middle pixel) colours the tile's pixels that no box
+  // holds; a tile whose ray meets a cone takes the ground's colour under the
+  // hit from the height field's own normal
+  if (!flat_ground) {
+    tiles_.clear();
+    for (int tj = 0; tj < H; tj += kGroundTile) {
+      const int j = std::min(H - 1, tj + kGroundTile / 2);
+      for (int ti = 0; ti < W; ti += kGroundTile) {
+        const int i = std::min(W - 1, ti + kGroundTile / 2);
+        tiles_.push_back(static_cast<std::uint32_t>(j * W + i));
+      }
+    }
+    cast(tiles_, [&](std::uint32_t p, const RTCRayHit16& rh, int k) {
+      const std::int32_t cone = world.cone_of(rh.hit.geomID[k], rh.hit.primID[k]);
+      if (cone < -1) return;
+      double lambert = 0.0;
+      if (cone == -1) {
+        lambert = lambert_of(rh, k);
+      } else {
+        const double t = rh.ray.tfar[k];
+        const double x = o[0] + t * rh.ray.dir_x[k], y = o[1] + t * rh.ray.dir_y[k];
+        const double e = 0.05;  // m, central differences of the height field
+        const double gx = (world.ground_z(x + e, y) - world.ground_z(x - e, y)) / (2.0 * e);
+        const double gy = (world.ground_z(x, y + e) - world.ground_z(x, y - e)) / (2.0 * e);
+        lambert = std::max(0.0, (-gx * sun_[0] - gy * sun_[1] + sun_[2]) / std::sqrt(gx * gx + gy * gy + 1.0));
+      }
+      const std::array<std::uint8_t, 3> rgb = shade(params_.ground, lambert);
+      const int i = static_cast<int>(p % static_cast<std::uint32_t>(W));
+      const int j = static_cast<int>(p / static_cast<std::uint32_t>(W));
+      const int i0 = i - kGroundTile / 2, j0 = j - kGroundTile / 2;
+      for (int jj = std::max(0, j0); jj < std::min(H, j0 + kGroundTile); ++jj) {
+        for (int ii = std::max(0, i0); ii < std::min(W, i0 + kGroundTile); ++ii) {
+          const std::size_t q = static_cast<std::size_t>(jj) * static_cast<std::size_t>(W) + static_cast<std::size_t>(ii);
+          if (stamp_[q] == frame_) continue;
+          std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(q));
+        }
+      }
+    });
+  }
+
+  // the boxes' pixels, each its own ray
+  carry_.clear();
+  carry_t_.clear();
+  cast(cast_, [&](std::uint32_t p, const RTCRayHit16& rh, int k) {
+    const std::int32_t cone = world.cone_of(rh.hit.geomID[k], rh.hit.primID[k]);
+    if (cone < -1) return;
+    if (cone == -1 && flat_ground) return;  // the analytic ground is the same
+    const double t = rh.ray.tfar[k];
+    const LidarMaterial m =
+        cone < 0 ? LidarMaterial::Ground
+                 : world.material_of(rh.hit.geomID[k], rh.hit.primID[k], o[0] + t * rh.ray.dir_x[k],
+                                     o[1] + t * rh.ray.dir_y[k], o[2] + t * rh.ray.dir_z[k]);
+    const std::array<std::uint8_t, 3> rgb = shade(albedo(params_, m), lambert_of(rh, k));
+    std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
+    if (cone >= 0) {
+      out.labels[p] = cone;
+      ++visible_[static_cast<std::size_t>(cone)];
+      ++unoccluded_[static_cast<std::size_t>(cone)];
+      if (cover_[p] < 2) return;  // no other cone's box: nothing behind to count
+    }
+    // carried on: a cone hit where boxes overlap, or (non-flat) a ground hit
+    // in a box, which a hill may have put in front of the cone (not when the
+    // hit lies beyond every cone whose box holds the pixel)
+    if (cone < 0 && t >= reach_[p]) return;
+    carry_.push_back(p);
+    carry_t_.push_back(static_cast<float>(t));
+  });
+
+  // rays carried on past their first hit: every cone they meet would be seen
+  // there but for the occluder in front; each counts once per pixel
+  for (std::size_t q = 0; q < carry_.size(); ++q) {
+    const std::uint32_t p = carry_[q];
+    double d[3];
+    ray_dir(p, d);
+    std::int32_t seen[8];
+    int n_seen = 0;
+    if (out.labels[p] >= 0) seen[n_seen++] = out.labels[p];
+    float tnear = carry_t_[q];
+    for (int it = 0; it < kMaxCarry; ++it) {
+      RTCRayHit rh;
+      rh.ray.org_x = o_x;
+      rh.ray.org_y = o_y;
+      rh.ray.org_z = o_z;
+      rh.ray.dir_x = static_cast<float>(d[0]);
+      rh.ray.dir_y = static_cast<float>(d[1]);
+      rh.ray.dir_z = static_cast<float>(d[2]);
+      rh.ray.tnear = tnear + static_cast<float>(kCarryStep);
+      rh.ray.tfar = reach_[p];  // nothing beyond the boxes' cones matters
+      rh.ray.time = 0.0f;
+      rh.ray.mask = 0xFFFFFFFFu;
+      rh.ray.id = 0;
+      rh.ray.flags = 0;
+      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(world.scene(), &context, &rh);
+      ++last_continued_rays_;
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
+      const std::int32_t cone = world.cone_of(rh.hit.geomID, rh.hit.primID);
+      if (cone < -1) break;
+      tnear = rh.ray.tfar;
+      if (cone == -1) {
+        if (flat_ground) break;  // below the plane from here on
+        continue;
+      }
+      if (std::find(seen, seen + n_seen, cone) != seen + n_seen) continue;
+      ++unoccluded_[static_cast<std::size_t>(cone)];
+      if (n_seen < 8) seen[n_seen++] = cone;
+    }
+  }
+
+  // instances, by cone index
+  std::sort(boxed_.begin(), boxed_.end(),
+            [this](std::int32_t a, std::int32_t b) { return cones_[static_cast<std::size_t>(a)].id < cones_[static_cast<std::size_t>(b)].id; });
+  for (std::int32_t s : boxed_) {
+    const ConeGeom& c = cones_[static_cast<std::size_t>(s)];
+    const auto id = static_cast<std::size_t>(c.id);
+    if (visible_[id] == 0) continue;
+    hal::CameraInstance inst;
+    inst.id = c.id;
+    double mid[3];
+    inst.color = cone_class(world, c, mid);
+    inst.range = std::sqrt((mid[0] - o[0]) * (mid[0] - o[0]) + (mid[1] - o[1]) * (mid[1] - o[1]) +
+                           (mid[2] - o[2]) * (mid[2] - o[2]));
+    inst.visible_fraction =
+        std::min(1.0, static_cast<double>(visible_[id]) / static_cast<double>(std::max(unoccluded_[id], 1)));
+    out.instances.push_back(inst);
+  }
+
+  // pixel noise: per channel a 12-bit uniform draw picks one of the 4096
+  // quantiles of N(0, pixel_noise^2) (noise_ table; five draws per 64-bit
+  // word of a splitmix64 stream seeded from rng_ once a frame)
+  if (!noise_.empty()) {
+    std::uint64_t s = rng_();
+    std::uint64_t r = 0;
+    int left = 0;
+    for (std::uint8_t& byte : out.rgb) {
+      if (left == 0) {
+        r = splitmix(s);
+        left = 5;
+      }
+      const int v = byte + noise_[r & 0xFFFu];
+      r >>= 12;
+      --left;
+      byte = static_cast<std::uint8_t>(std::clamp(v, 0, 255));
+    }
+  }
+}
+
+}  // namespace paddock::sensors

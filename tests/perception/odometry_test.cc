@@ -1,0 +1,85 @@
+// the dead-reckoning odometry against the analytic motion: a constant speed
+// and yaw rate make a circular arc, x = v/w sin(w t), y = v/w (1 - cos(w t)).
+#include "autonomy/perception/odometry.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+namespace paddock::perception {
+namespace {
+
+constexpr double kTrackRear = 1.2;  // m, the default vehicle's rear track
+
+// exact messages of a constant motion: IMU at 200 Hz, wheel speeds at 100 Hz
+void feed(Odometry& odo, double v, double w, TimeNs from, TimeNs to) {
+  const double r = odo.params().wheel_radius;
+  for (TimeNs t = from; t <= to; t += 5'000'000) {
+    odo.add(hal::Imu{t, 0.0, v * w, w});
+    if ((t - from) % 10'000'000 == 0) {
+      // rear wheels at -+ track/2: v -+ w track/2; the front ones are ignored
+      hal::WheelSpeeds ws{t, {123.0, -7.0, (v - w * 0.5 * kTrackRear) / r, (v + w * 0.5 * kTrackRear) / r}};
+      odo.add(ws);
+    }
+  }
+}
+
+TEST(OdometryTest, ConstantTurnGivesTheAnalyticArc) {
+  Odometry odo;
+  const double v = 10.0, w = 1.0;
+  feed(odo, v, w, 0, from_seconds(1.0));
+  for (const auto& [a, b] : {std::pair{0.2, 0.5}, std::pair{0.5, 0.2}, std::pair{0.31, 0.3125}, std::pair{0.0, 1.0}}) {
+    const std::optional<Pose2> rel = odo.relative(from_seconds(a), from_seconds(b));
+    ASSERT_TRUE(rel.has_value()) << a << " -> " << b;
+    const double th = w * (b - a);
+    EXPECT_NEAR(rel->x, v / w * std::sin(th), 1e-3);
+    EXPECT_NEAR(rel->y, v / w * (1.0 - std::cos(th)), 1e-3);
+    EXPECT_NEAR(rel->yaw, th, 1e-6);
+  }
+}
+
+TEST(OdometryTest, StraightLineAndExtrapolationLimits) {
+  OdometryParams p;
+  p.extrapolation = 0.02;
+  Odometry odo(p);
+  feed(odo, 5.0, 0.0, from_seconds(1.0), from_seconds(2.0));
+  const std::optional<Pose2> rel = odo.relative(from_seconds(1.5), from_seconds(2.01));
+  ASSERT_TRUE(rel.has_value());
+  EXPECT_NEAR(rel->x, 5.0 * 0.51, 1e-9);
+  EXPECT_NEAR(rel->y, 0.0, 1e-12);
+  EXPECT_FALSE(odo.relative(from_seconds(1.5), from_seconds(2.05)).has_value());
+  EXPECT_FALSE(odo.relative(from_seconds(0.9), from_seconds(1.5)).has_value());
+  EXPECT_TRUE(odo.relative(from_seconds(0.99), from_seconds(1.5)).has_value());
+}
+
+TEST(OdometryTest, HistoryIsBoundedAndBadMessagesAreIgnored) {
+  OdometryParams p;
+  p.history = 0.5;
+  Odometry odo(p);
+  EXPECT_FALSE(odo.relative(0, 0).has_value());  // nothing yet
+  feed(odo, 3.0, 0.2, 0, from_seconds(2.0));
+  EXPECT_FALSE(odo.relative(from_seconds(1.0), from_seconds(2.0)).has_value());
+  EXPECT_TRUE(odo.relative(from_seconds(1.6), from_seconds(2.0)).has_value());
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  odo.add(hal::Imu{from_seconds(2.001), 0.0, 0.0, nan});
+  odo.add(hal::WheelSpeeds{from_seconds(2.002), {0.0, 0.0, nan, 1.0}});
+  odo.add(hal::Imu{from_seconds(1.0), 0.0, 0.0, 0.0});  // backwards in time
+  EXPECT_EQ(odo.rejected(), 3u);
+  const std::optional<Pose2> rel = odo.relative(from_seconds(1.8), from_seconds(2.0));
+  ASSERT_TRUE(rel.has_value());
+  EXPECT_NEAR(rel->yaw, 0.2 * 0.2, 1e-9);
+}
+
+TEST(OdometryTest, ValidateNamesTheField) {
+  OdometryParams p;
+  EXPECT_EQ(validate(p), "");
+  p.wheel_radius = -1.0;
+  EXPECT_EQ(validate(p).rfind("wheel_radius", 0), 0u);
+  p = OdometryParams{};
+  p.history = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(validate(p).rfind("history", 0), 0u);
+}
+
+}  // namespace
+}  // namespace paddock::perception
