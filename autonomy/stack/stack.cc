@@ -34,6 +34,11 @@ Stack::Stack(const StackParams& params, MissionSpec spec)
       controller_(params.control, params.vehicle),
       cone_map_(params.cone_map),
       gates_(spec_.gates) {
+  if (params_.modes.perception != PerceptionMode::GroundTruth) {
+    perception::PerceptionParams pp = params_.perception;
+    pp.use_camera = params_.modes.perception == PerceptionMode::LidarCamera;
+    perception_ = std::make_unique<perception::Perception>(pp, params_.seed);
+  }
   if (params_.modes.planner != PlannerMode::Oracle) return;
   // planner = oracle: the whole reference is planned once, before the start;
   // an open path starts free (the car launches at full drive) and ends at rest
@@ -47,7 +52,7 @@ Stack::Stack(const StackParams& params, MissionSpec spec)
   }
 }
 
-void Stack::on_message(const hal::SensorMessage& m) {
+void Stack::on_message(hal::SensorMessage&& m) {
   if (const auto* est = std::get_if<hal::StateEstimate>(&m)) {
     state_ = *est;
     history_.push_back(*est);
@@ -57,6 +62,16 @@ void Stack::on_message(const hal::SensorMessage& m) {
   } else if (const auto* res = std::get_if<hal::ResSignal>(&m)) {
     go_ = go_ || res->go;
     emergency_ = emergency_ || res->emergency;
+  } else if (!perception_) {
+    // perception = ground_truth: the raw sensors' messages are not used
+  } else if (const auto* scan = std::get_if<hal::LidarScan>(&m)) {
+    on_detections(perception_->process(*scan));
+  } else if (auto* frame = std::get_if<hal::CameraFrame>(&m)) {
+    perception_->add(std::move(*frame));
+  } else if (const auto* imu = std::get_if<hal::Imu>(&m)) {
+    perception_->add(*imu);
+  } else if (const auto* wheels = std::get_if<hal::WheelSpeeds>(&m)) {
+    perception_->add(*wheels);
   }
 }
 
@@ -76,7 +91,17 @@ std::optional<Pose2> Stack::pose_at(TimeNs t) const {
 void Stack::on_detections(const hal::ConeDetections& d) {
   last_detections_ = d;
   ++detection_frames_;
-  // slam = ground_truth: the detections go into the map at the pose the car had when they were measured
+  // slam = ground_truth: the detections go into the map at the pose the car
+  // had when they were measured; a frame newer than the newest state estimate
+  // waits for it (a scan closes just before the state of that instant arrives)
+  if (!history_.empty() && d.stamp > history_.back().stamp) {
+    waiting_.push_back(d);
+    return;
+  }
+  add_to_map(d);
+}
+
+void Stack::add_to_map(const hal::ConeDetections& d) {
   const std::optional<Pose2> pose = pose_at(d.stamp);
   if (!pose) return;
   std::vector<Cone> in_map;
@@ -196,7 +221,13 @@ hal::ActuatorCommand Stack::safe_stop(TimeNs now, const std::string& reason) {
 }
 
 void Stack::tick(TimeNs now, hal::Hal& hal) {
-  while (auto m = hal.receive()) on_message(*m);
+  while (auto m = hal.receive()) on_message(std::move(*m));
+  // frames that came before the state estimate of their instant
+  while (!waiting_.empty() && !history_.empty() && waiting_.front().stamp <= history_.back().stamp) {
+    add_to_map(waiting_.front());
+    waiting_.pop_front();
+  }
+  while (waiting_.size() > 4) waiting_.pop_front();  // no state estimates: the old frames are of no use
   const double dt = last_tick_ ? to_seconds(now - *last_tick_) : 0.0;
   last_tick_ = now;
 

@@ -1,7 +1,9 @@
 #pragma once
 // the autonomy pipeline behind the HAL: the AS state machine, the mission
 // logic of each event, the cone map, planning and control at the control rate.
+#include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "autonomy/common/trajectory.h"
 #include "autonomy/control/controller.h"
 #include "autonomy/hal/hal.h"
+#include "autonomy/perception/perception.h"
 #include "autonomy/planning/path_planner.h"
 #include "autonomy/planning/skidpad.h"
 #include "autonomy/slam/cone_map.h"
@@ -71,6 +74,9 @@ struct MissionParams {
 
 struct StackParams {
   AutonomyModes modes;
+  // perception = lidar | lidar_camera (use_camera follows the mode)
+  perception::PerceptionParams perception;
+  std::uint64_t seed = 1;  // the stack's own random draws (the simulated detector's error model)
   planning::PathPlannerParams planner;   // its reference params serve the oracle mode too
   planning::SkidpadParams skidpad;
   control::ControlParams control;
@@ -126,14 +132,18 @@ class Stack {
   // the map the last plan was made on (its triangulation indexes these)
   const std::vector<Cone>& last_plan_cones() const { return last_plan_cones_; }
   const std::vector<Segment>& gates() const { return gates_; }
+  // perception = lidar | lidar_camera: the pipeline (its last frame, stats), else null
+  perception::Perception* perception() { return perception_.get(); }
+  const perception::Perception* perception() const { return perception_.get(); }
   // the last frame of cones perception delivered (base frame at its stamp) and
   // how many frames came so far: for the perception metrics
   const hal::ConeDetections& last_detections() const { return last_detections_; }
   long detection_frames() const { return detection_frames_; }
 
  private:
-  void on_message(const hal::SensorMessage& m);
+  void on_message(hal::SensorMessage&& m);
   void on_detections(const hal::ConeDetections& d);
+  void add_to_map(const hal::ConeDetections& d);
   // the base pose at time t from the recent state estimates (interpolated), if known
   std::optional<Pose2> pose_at(TimeNs t) const;
   // planner = delaunay: a new plan from the cone map when the map has news
@@ -148,11 +158,13 @@ class Stack {
   Trajectory trajectory_;
   control::Controller controller_;
   Telemetry telemetry_;
+  std::unique_ptr<perception::Perception> perception_;
 
   std::optional<hal::StateEstimate> state_;
   std::deque<hal::StateEstimate> history_;  // the last second of state estimates, oldest first
   slam::ConeMap cone_map_;
   bool map_news_ = false;                   // detections since the last plan
+  std::deque<hal::ConeDetections> waiting_;  // frames newer than the newest state estimate
   hal::ConeDetections last_detections_;
   long detection_frames_ = 0;
   planning::PlanResult last_plan_;

@@ -17,8 +17,11 @@ std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t 
   return hit;
 }
 
-RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground, std::uint64_t seed)
-    : lidar_(lidar, seed), ground_(ground), poses_(2 * lidar_.period_ns()) {}
+RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
+                       const std::optional<sensors::CameraParams>& camera, std::uint64_t seed)
+    : lidar_(lidar, seed), ground_(ground), poses_(2 * lidar_.period_ns()) {
+  if (camera) camera_ = std::make_unique<sensors::Camera>(*camera, seed ^ 0xC0FFEEULL);
+}
 
 void RawSensors::record(TimeNs now, const Pose2& base) { poses_.record(now, base); }
 
@@ -68,6 +71,10 @@ void RawSensors::update_scene(const world::ConeWorld& cones) {
 const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeWorld& cones, SimHal& hal) {
   update_scene(cones);
   const TimeNs start = now - lidar_.period_ns();
+  if (camera_) {
+    const TimeNs exposure = sensors::trigger_time(lidar_.params(), camera_->params().trigger_azimuth, start);
+    hal.post(camera_->render(*world_, poses_.at(exposure), exposure));
+  }
   const std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [this](TimeNs t) { return poses_.at(t); }, start);
   hal::LidarScan scan;
   scan.stamp = start;

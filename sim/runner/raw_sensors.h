@@ -11,11 +11,13 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include "autonomy/hal/messages.h"
 #include "sim/runner/sim_hal.h"
+#include "sim/sensors/camera.h"
 #include "sim/sensors/lidar.h"
 #include "sim/world/cone_world.h"
 
@@ -39,14 +41,17 @@ std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t 
 
 class RawSensors {
  public:
-  RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground, std::uint64_t seed);
+  // camera: the camera the LiDAR triggers (perception = lidar_camera), or none
+  RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
+             const std::optional<sensors::CameraParams>& camera, std::uint64_t seed);
 
   // the base pose at `now` (call every physics step, times increasing)
   void record(TimeNs now, const Pose2& base);
   // true when a rotation ends at `now` (one starts at 0, then every period)
   bool rotation_ends(TimeNs now) const;
   // casts the rotation that ends at `now` against the cones as they stand and
-  // posts the scan; returns its ground truth: per point the cone index hit
+  // posts the camera frame it triggered (exposed at the trigger column's time,
+  // from the pose of that instant), then the scan; returns its ground truth: per point the cone index hit
   // (-1 the ground), in the order of the scan's points
   const std::vector<std::int32_t>& emit(TimeNs now, const world::ConeWorld& cones, SimHal& hal);
 
@@ -56,6 +61,7 @@ class RawSensors {
   void update_scene(const world::ConeWorld& cones);
 
   sensors::Lidar lidar_;
+  std::unique_ptr<sensors::Camera> camera_;
   sensors::GroundParams ground_;
   std::unique_ptr<sensors::LidarWorld> world_;
   std::vector<Cone> scene_cones_;

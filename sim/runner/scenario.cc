@@ -210,6 +210,19 @@ void add_lidar_fields(std::vector<Field>& f) {
   f.push_back(real_field("lidar", "intensity_range_ref", "m", 0.01, 1000.0, "intensity falls off as (ref / r)^2 beyond this",
                          ACC(lidar.intensity_range_ref)));
   f.push_back(real_field("lidar", "intensity_noise", "", 0.0, 1.0, "intensity noise std", ACC(lidar.intensity_noise)));
+  f.push_back(int_field("camera", "width", "px", 16, 8192, "image width", ACC(camera.width)));
+  f.push_back(int_field("camera", "height", "px", 16, 8192, "image height", ACC(camera.height)));
+  f.push_back(real_field("camera", "hfov", "rad", 10.0 * kPi / 180.0, 170.0 * kPi / 180.0, "horizontal field of view", ACC(camera.hfov)));
+  f.push_back(real_field("camera", "mount_x", "m", -10.0, 10.0, "optical centre ahead of the rear axle", ACC(camera.mount_x)));
+  f.push_back(real_field("camera", "mount_y", "m", -5.0, 5.0, "optical centre left of the centre", ACC(camera.mount_y)));
+  f.push_back(real_field("camera", "mount_z", "m", 0.01, 5.0, "optical centre above the ground", ACC(camera.mount_z)));
+  f.push_back(real_field("camera", "mount_pitch", "rad", -1.5, 1.5, "pitch, > 0 nose down", ACC(camera.mount_pitch)));
+  f.push_back(real_field("camera", "trigger_azimuth", "rad", -kPi, kPi, "the LiDAR azimuth that triggers the exposure (0 ahead)",
+                         ACC(camera.trigger_azimuth)));
+  f.push_back(real_field("camera", "sun_azimuth", "rad", -kPi, kPi, "sun direction from map +x", ACC(camera.sun_azimuth)));
+  f.push_back(real_field("camera", "sun_elevation", "rad", 0.0, kPi / 2, "sun height", ACC(camera.sun_elevation)));
+  f.push_back(real_field("camera", "ambient", "", 0.0, 1.0, "ambient light share", ACC(camera.ambient)));
+  f.push_back(real_field("camera", "pixel_noise", "", 0.0, 64.0, "pixel noise std in 8-bit levels", ACC(camera.pixel_noise)));
   f.push_back(real_field("ground", "slope_x", "", -1.0, 1.0, "dz/dx of the ground plane (map frame)", ACC(ground.slope_x)));
   f.push_back(real_field("ground", "slope_y", "", -1.0, 1.0, "dz/dy of the ground plane (map frame)", ACC(ground.slope_y)));
   f.push_back(real_field("ground", "bump_height", "m", 0.0, 1.0, "amplitude of the sinusoidal bumps", ACC(ground.bump_height)));
@@ -542,6 +555,7 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   if (const std::string why = sensors::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
   if (const std::string why = sensors::validate(s.lidar); !why.empty()) throw UserError(path + ": [lidar] " + why);
   if (const std::string why = sensors::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
+  if (const std::string why = sensors::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
 
   s.source = path;
   s.name = std::filesystem::path(path).stem().string();
@@ -594,6 +608,20 @@ stack::StackParams stack_params(const Scenario& s) {
   k.max_brake_force = v.brake_force_max;
   k.drag_coefficient = v.c_drag;
   k.rolling_resistance = v.cr0;
+  // perception: the sensors' calibration is their true mounting and layout,
+  // the odometry's wheel radius the car's
+  p.seed = s.scenario.seed * 0x9E3779B97F4A7C15ULL + 6;
+  p.perception.odometry.wheel_radius = v.wheel_radius;
+  perception::LidarCalibration& lc = p.perception.lidar.calibration;
+  lc.mount_x = s.lidar.mount_x;
+  lc.mount_y = s.lidar.mount_y;
+  lc.mount_z = s.lidar.mount_z;
+  lc.mount_pitch = s.lidar.mount_pitch;
+  lc.channels = s.lidar.channels;
+  lc.elevation_min = s.lidar.elevation_min;
+  lc.elevation_max = s.lidar.elevation_max;
+  lc.columns = s.lidar.columns;
+  p.perception.camera = sensors::camera_calibration(s.camera);
   p.planner = s.planning;
   p.planner.reference.profile.mass = v.mass;
   p.planner.reference.profile.drag_coefficient = v.c_drag;

@@ -10,6 +10,7 @@
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
 #include "sim/sensors/cone_sensor.h"
+#include "sim/sensors/camera.h"
 #include "sim/sensors/imu.h"
 #include "sim/sensors/lidar.h"
 #include "sim/sensors/odometry_sensors.h"
@@ -62,6 +63,7 @@ struct Scenario {
   sensors::WheelSpeedParams wheel_speeds;  // [wheel_speeds]
   sensors::SteeringSensorParams steering_sensor;  // [steering_sensor]
   sensors::LidarParams lidar;             // [lidar]: the rotating LiDAR of perception = lidar, lidar_camera
+  sensors::CameraParams camera;           // [camera]: the camera of perception = lidar_camera
   sensors::GroundParams ground;           // [ground]: the ground's shape, as the sensors see it
   vehicle::VehicleParams vehicle;
   control::ControlParams control;

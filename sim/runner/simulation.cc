@@ -155,7 +155,11 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   // perception = lidar | lidar_camera: the raw sensors instead of the cone sensor
   const bool raw_perception = sc.autonomy.perception != stack::PerceptionMode::GroundTruth;
   std::unique_ptr<RawSensors> raw;
-  if (raw_perception) raw = std::make_unique<RawSensors>(sc.lidar, sc.ground, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 5);
+  if (raw_perception) {
+    std::optional<sensors::CameraParams> camera;
+    if (sc.autonomy.perception == stack::PerceptionMode::LidarCamera) camera = sc.camera;
+    raw = std::make_unique<RawSensors>(sc.lidar, sc.ground, camera, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 5);
+  }
 
   // perception metrics: each frame the stack got, against the truth of its instant
   PerceptionMetrics metrics;
