@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "render/figures.h"
 #include "sim/runner/files.h"
 #include "sim/runner/plots.h"
 #include "sim/runner/reports.h"
@@ -109,6 +110,20 @@ int cmd_run(const std::vector<std::string>& args) {
   write_file_atomic(out_dir + "/log.csv", log_csv(result.log));
   write_file_atomic(out_dir + "/plan.json", plan_json(result));
   write_file_atomic(out_dir + "/summary.json", js);
+  if (result.snapshot) {
+    write_file_atomic(out_dir + "/perception.json", perception_json(*result.snapshot));
+    if (result.snapshot->camera) {
+      const PerceptionSnapshot& s = *result.snapshot;
+      render::Image img;
+      img.width = s.width;
+      img.height = s.height;
+      img.rgba.resize(static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height) * 4, 255);
+      for (std::size_t i = 0; i < s.rgb.size() / 3; ++i)
+        for (std::size_t c = 0; c < 3; ++c) img.rgba[4 * i + c] = s.rgb[3 * i + c];
+      const std::vector<std::uint8_t> png = render::encode_png(img);
+      write_file_atomic(out_dir + "/camera.png", std::string(png.begin(), png.end()));
+    }
+  }
 
   std::vector<std::string> figures;
   if (plots) figures = plot_run(out_dir, plot_options);

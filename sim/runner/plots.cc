@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -100,6 +101,70 @@ void add_plan_layers(const std::string& path, render::TrackMapData& map) {
 void write_png(const std::string& path, const render::Image& image) {
   const std::vector<std::uint8_t> png = render::encode_png(image);
   write_file_atomic(path, std::string(png.begin(), png.end()));
+}
+
+ConeColor color_of_tag(const std::string& tag) {
+  for (ConeColor k : {ConeColor::Blue, ConeColor::Yellow, ConeColor::SmallOrange, ConeColor::BigOrange})
+    if (tag == cone_tag(k)) return k;
+  return ConeColor::Unknown;
+}
+
+// DIR/perception.json (and camera.png) -> the LiDAR view and the camera view
+std::vector<std::string> plot_perception(const std::string& dir, const render::FigureStyle& map_style,
+                                         const render::FigureStyle& chart_style) {
+  const std::string path = dir + "/perception.json";
+  std::vector<std::string> out;
+  if (!std::filesystem::exists(path)) return out;
+  render::LidarViewData lidar;
+  render::CameraViewData camera;
+  bool has_camera = false;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(read_file(path));
+    auto cones = [](const nlohmann::json& a) {
+      std::vector<Cone> cs;
+      for (const auto& c : a) cs.push_back({{c.at(0).get<double>(), c.at(1).get<double>()}, color_of_tag(c.at(2).get<std::string>())});
+      return cs;
+    };
+    char when[32];
+    std::snprintf(when, sizeof when, "%.1f", j.at("t").get<double>());
+    lidar.title = "LiDAR scan at t = " + std::string(when) + " s: ground, non-ground, cones";
+    for (const auto& p : j.at("points"))
+      lidar.points.push_back({p.at(0).get<float>(), p.at(1).get<float>(), p.at(3).get<std::uint8_t>()});
+    lidar.detected = cones(j.at("detected"));
+    lidar.truth = cones(j.at("truth"));
+    if (j.contains("camera")) {
+      const auto& c = j.at("camera");
+      has_camera = true;
+      camera.title = "camera at t = " + std::string(when) + " s: detections and projected LiDAR cluster centres";
+      camera.width = c.at("width").get<int>();
+      camera.height = c.at("height").get<int>();
+      for (const auto& b : c.at("boxes"))
+        camera.boxes.push_back({b.at(0).get<double>(), b.at(1).get<double>(), b.at(2).get<double>(), b.at(3).get<double>(),
+                                color_of_tag(b.at(4).get<std::string>())});
+      for (const auto& p : c.at("projected")) camera.projected.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
+      for (const auto& p : c.at("dropped")) camera.dropped.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
+      const std::string png = read_file(dir + "/" + c.at("image").get<std::string>());
+      const render::Image img = render::decode_png(std::vector<std::uint8_t>(png.begin(), png.end()));
+      if (img.width != camera.width || img.height != camera.height)
+        throw UserError(dir + "/camera.png: " + std::to_string(img.width) + "x" + std::to_string(img.height) +
+                        " px, perception.json says " + std::to_string(camera.width) + "x" + std::to_string(camera.height));
+      camera.rgb.resize(static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height) * 3);
+      for (std::size_t i = 0; i < camera.rgb.size() / 3; ++i)
+        for (std::size_t k = 0; k < 3; ++k) camera.rgb[3 * i + k] = img.rgba[4 * i + k];
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw UserError(path + ": not a paddock perception snapshot: " + e.what());
+  }
+  out.push_back(dir + "/lidar_view.png");
+  write_png(out.back(), render::draw_lidar_view(lidar, map_style).image);
+  if (has_camera) {
+    render::FigureStyle style = chart_style;
+    // the image's aspect, plus room for the title and legend
+    style.height = std::max(400, static_cast<int>(style.width * camera.height / std::max(1, camera.width)) + 300);
+    out.push_back(dir + "/camera_view.png");
+    write_png(out.back(), render::draw_camera_view(camera, style).image);
+  }
+  return out;
 }
 
 }  // namespace
@@ -215,10 +280,11 @@ std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) 
   chart.doo_penalty = rules.doo_penalty;
   chart.oc_penalty = rules.oc_penalty;
 
-  const std::vector<std::string> paths = {dir + "/map.png", dir + "/controller.png", dir + "/laps.png"};
+  std::vector<std::string> paths = {dir + "/map.png", dir + "/controller.png", dir + "/laps.png"};
   write_png(paths[0], render::draw_track_map(map, map_style).image);
   write_png(paths[1], render::draw_controller_data(ctl, chart_style).image);
   write_png(paths[2], render::draw_lap_chart(chart, chart_style).image);
+  for (const std::string& p : plot_perception(dir, map_style, chart_style)) paths.push_back(p);
   return paths;
 }
 

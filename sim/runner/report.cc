@@ -199,6 +199,31 @@ std::string plan_json(const RunResult& r) {
   return j.dump() + "\n";
 }
 
+std::string perception_json(const PerceptionSnapshot& s) {
+  using Json = nlohmann::ordered_json;
+  Json points = Json::array();
+  for (const PerceptionSnapshot::Point& p : s.points) points.push_back({p.x, p.y, p.z, p.label});
+  auto cones = [](const std::vector<Cone>& cs) {
+    Json a = Json::array();
+    for (const Cone& c : cs) a.push_back({c.position.x, c.position.y, std::string(cone_tag(c.color))});
+    return a;
+  };
+  auto pixels = [](const std::vector<Vec2>& ps) {
+    Json a = Json::array();
+    for (const Vec2& p : ps) a.push_back({p.x, p.y});
+    return a;
+  };
+  Json boxes = Json::array();
+  for (const PerceptionSnapshot::Box& b : s.boxes)
+    boxes.push_back({b.x_min, b.y_min, b.x_max, b.y_max, std::string(cone_tag(b.color))});
+  Json j = {{"t", s.t}, {"points", points}, {"detected", cones(s.detected)}, {"truth", cones(s.truth)}};
+  if (s.camera) {
+    j["camera"] = {{"width", s.width}, {"height", s.height}, {"image", "camera.png"}, {"boxes", boxes},
+                   {"projected", pixels(s.projected)}, {"dropped", pixels(s.dropped)}};
+  }
+  return j.dump() + "\n";
+}
+
 std::string log_csv(const std::vector<LogRow>& log) {
   std::string out =
       "t,x,y,yaw,vx,vy,yaw_rate,steer_cmd,steer,throttle,brake,v_ref,lateral_error,heading_error,s,lap,as_state\n";

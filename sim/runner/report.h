@@ -21,6 +21,13 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
 // the stack's last plan and map (plan.json): the map's optional layers
 std::string plan_json(const RunResult& r);
 
+// the perception snapshot (perception.json): scan time, labelled points
+// [x, y, z, label], detected and true cones [x, y, colour tag] in the base
+// frame, and the camera's boxes [x_min, y_min, x_max, y_max, colour tag] and
+// projected cluster centres [u, v] (kept and dropped); the camera image goes
+// to camera.png beside it
+std::string perception_json(const PerceptionSnapshot& s);
+
 // the log rows as CSV with a header line
 std::string log_csv(const std::vector<LogRow>& log);
 

@@ -230,6 +230,35 @@ void add_lidar_fields(std::vector<Field>& f) {
   f.push_back(real_field("ground", "cell", "m", 0.01, 100.0, "height-field grid cell (a lower bound)", ACC(ground.cell)));
 }
 
+// [perception], [detector]: the stack's perception front
+void add_perception_fields(std::vector<Field>& f) {
+  f.push_back(real_field("perception", "cluster_tolerance", "m", 0.01, 5.0, "Euclidean clustering: largest gap inside a cluster",
+                         ACC(perception.lidar.clustering.tolerance)));
+  f.push_back(real_field("perception", "cluster_max_range", "m", 1.0, 200.0, "only points this close are clustered",
+                         ACC(perception.lidar.clustering.max_range)));
+  f.push_back(real_field("perception", "camera_range", "m", 0.1, 200.0, "fusion: beyond this the camera is not trusted (LiDAR only)",
+                         ACC(perception.fusion.camera_range)));
+  f.push_back(real_field("perception", "box_margin", "px", 0.0, 100.0, "fusion: a projected centre this far outside a box is in it",
+                         ACC(perception.fusion.box_margin)));
+  f.push_back(real_field("perception", "camera_sync_tolerance", "s", 0.0, 1.0, "a camera frame serves the rotation it was exposed in, give or take this",
+                         ACC(perception.camera_sync_tolerance)));
+  f.push_back(real_field("detector", "p_miss_near", "", 0.0, 1.0, "chance of missing an unoccluded cone up to range_full",
+                         ACC(perception.detector.p_miss_near)));
+  f.push_back(real_field("detector", "range_full", "m", 0.0, 1000.0, "misses start to grow beyond this", ACC(perception.detector.range_full)));
+  f.push_back(real_field("detector", "range_max", "m", 0.0, 1000.0, "every cone is missed beyond this", ACC(perception.detector.range_max)));
+  f.push_back(real_field("detector", "visible_min", "", 0.0, 1.0, "a cone less visible than this is always missed",
+                         ACC(perception.detector.visible_min)));
+  f.push_back(real_field("detector", "visible_full", "", 0.0, 1.0, "occlusion adds no misses above this visible share",
+                         ACC(perception.detector.visible_full)));
+  f.push_back(real_field("detector", "p_confuse_blue_yellow", "", 0.0, 1.0, "chance of calling blue yellow or yellow blue",
+                         ACC(perception.detector.p_confuse_blue_yellow)));
+  f.push_back(real_field("detector", "p_confuse_orange_size", "", 0.0, 1.0, "chance of calling a small orange big or a big one small",
+                         ACC(perception.detector.p_confuse_orange_size)));
+  f.push_back(real_field("detector", "box_jitter", "", 0.0, 1.0, "std of each box edge as a share of the box size",
+                         ACC(perception.detector.box_jitter)));
+  f.push_back(real_field("detector", "min_box_height", "px", 0.0, 1000.0, "smaller boxes are never found", ACC(perception.detector.min_box_height)));
+}
+
 // [cones]: the Box2D cone world's physics
 void add_cone_fields(std::vector<Field>& f) {
   f.push_back(real_field("cones", "small_mass", "kg", 0.01, 100.0, "small cone mass", ACC(cones.small_cone.mass)));
@@ -413,11 +442,14 @@ std::vector<Field> build_fields() {
   f.push_back(int_field("sim", "physics_rate", "Hz", 1, 100000, "vehicle and world integration rate", ACC(sim.physics_rate)));
   f.push_back(int_field("sim", "control_rate", "Hz", 1, 100000, "stack cycle rate", ACC(sim.control_rate)));
   f.push_back(int_field("sim", "log_rate", "Hz", 1, 100000, "log.csv rows and off-course checks", ACC(sim.log_rate)));
+  f.push_back(real_field("sim", "snapshot_time", "s", 0.0, 1e6, "the first LiDAR scan after this is kept for the perception figures",
+                         ACC(sim.snapshot_time)));
 
   // [cone_sensor], [vehicle] and [cones]: see add_cone_sensor_fields, add_vehicle_fields and add_cone_fields
   add_cone_sensor_fields(f);
   add_odometry_fields(f);
   add_lidar_fields(f);
+  add_perception_fields(f);
   add_vehicle_fields(f);
   add_cone_fields(f);
 
@@ -556,6 +588,11 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   if (const std::string why = sensors::validate(s.lidar); !why.empty()) throw UserError(path + ": [lidar] " + why);
   if (const std::string why = sensors::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
   if (const std::string why = sensors::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
+  if (const std::string why = perception::validate(stack_params(s).perception); !why.empty()) {
+    // "detector.range_max ..." is a [detector] key; the rest are [perception]'s or derived
+    if (why.rfind("detector.", 0) == 0) throw UserError(path + ": [detector] " + why.substr(9));
+    throw UserError(path + ": [perception] " + why);
+  }
 
   s.source = path;
   s.name = std::filesystem::path(path).stem().string();
@@ -611,6 +648,7 @@ stack::StackParams stack_params(const Scenario& s) {
   // perception: the sensors' calibration is their true mounting and layout,
   // the odometry's wheel radius the car's
   p.seed = s.scenario.seed * 0x9E3779B97F4A7C15ULL + 6;
+  p.perception = s.perception;
   p.perception.odometry.wheel_radius = v.wheel_radius;
   perception::LidarCalibration& lc = p.perception.lidar.calibration;
   lc.mount_x = s.lidar.mount_x;

@@ -34,6 +34,7 @@ struct SimSection {
   int physics_rate = 1000;  // Hz, vehicle and world integration
   int control_rate = 100;   // Hz, the stack's cycle (and the state estimate's rate)
   int log_rate = 100;       // Hz, rows of log.csv; also the rate of the off-course test
+  double snapshot_time = 12.0;  // s: the first scan after this is kept for the perception figures
 };
 
 // [expect]: what a CI scenario must achieve; unset entries are not checked
@@ -64,6 +65,9 @@ struct Scenario {
   sensors::SteeringSensorParams steering_sensor;  // [steering_sensor]
   sensors::LidarParams lidar;             // [lidar]: the rotating LiDAR of perception = lidar, lidar_camera
   sensors::CameraParams camera;           // [camera]: the camera of perception = lidar_camera
+  // [perception], [detector]: the stack's perception front (perception =
+  // lidar | lidar_camera); its calibration is filled from [lidar] and [camera]
+  perception::PerceptionParams perception;
   sensors::GroundParams ground;           // [ground]: the ground's shape, as the sensors see it
   vehicle::VehicleParams vehicle;
   control::ControlParams control;

@@ -44,6 +44,34 @@ std::vector<Vec2> skidpad_path(const world::SkidpadGeometry& g) {
   return p;
 }
 
+PerceptionSnapshot take_snapshot(const perception::Perception& p, const Pose2& pose, const world::ConeWorld& cones) {
+  const perception::PerceptionFrame& f = p.last();
+  PerceptionSnapshot s;
+  s.t = to_seconds(f.output.stamp);
+  for (const perception::LabelledPoint& q : f.lidar.points) {
+    const std::uint8_t label = q.label == perception::PointLabel::Ground ? 0 : q.label == perception::PointLabel::Cone ? 2 : 1;
+    s.points.push_back({q.x, q.y, q.z, label});
+  }
+  for (const hal::DetectedCone& c : f.output.cones) s.detected.push_back({c.position, c.color});
+  for (int i = 0; i < cones.cone_count(); ++i) {
+    const Vec2 local = pose.inverse_transform(cones.cone_position(i));
+    if (norm(local) <= 40.0) s.truth.push_back({local, cones.cone(i).color});
+  }
+  if (f.camera_used && p.camera_frame()) {
+    const hal::CameraFrame& frame = *p.camera_frame();
+    s.camera = true;
+    s.width = frame.width;
+    s.height = frame.height;
+    s.rgb = frame.rgb;
+    for (const perception::BoundingBox& b : f.detection.boxes) s.boxes.push_back({b.x_min, b.y_min, b.x_max, b.y_max, b.color});
+    for (const perception::FusedCone& c : f.fusion.cones) {
+      if (!c.projected) continue;
+      (c.source == perception::FusionSource::Dropped ? s.dropped : s.projected).push_back({c.pixel.x(), c.pixel.y()});
+    }
+  }
+  return s;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -170,6 +198,7 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   const Vec2 sensor_mount = raw_perception ? Vec2{sc.lidar.mount_x, sc.lidar.mount_y}
                                            : Vec2{sc.cone_sensor.mount_x, sc.cone_sensor.mount_y};
   long scored_frames = 0;
+  bool snapshot_armed = false;
   std::vector<Cone> truth_cones(static_cast<std::size_t>(cones.cone_count()));
 
   vehicle::DriverInput input{0.0, 0.0, 1.0};
@@ -239,7 +268,18 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
         go_sent = true;
         event.start(t);
       }
+      // the perception snapshot: keep the points of the first scan after snapshot_time
+      const bool snap_pending = raw && !res.snapshot && t >= sc.sim.snapshot_time;
+      if (snap_pending && !snapshot_armed) {
+        stack.perception()->set_keep_points(true);
+        snapshot_armed = true;
+      }
+      const long frames_before = stack.detection_frames();
       stack.tick(now, hal);
+      if (snap_pending && stack.detection_frames() > frames_before) {
+        res.snapshot = take_snapshot(*stack.perception(), truth_poses.at(stack.last_detections().stamp), cones);
+        stack.perception()->set_keep_points(false);
+      }
       if (stack.detection_frames() > scored_frames) {
         scored_frames = stack.detection_frames();
         const hal::ConeDetections& d = stack.last_detections();

@@ -1,6 +1,8 @@
 #pragma once
 // the closed loop: vehicle, cone world and event at the physics rate; the
 // stack behind the sim HAL at the control rate; log rows at the log rate.
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +65,31 @@ struct PlanSnapshot {
   std::vector<Vec2> reference;         // the trajectory it drove last
 };
 
+// one perception frame of the run, kept for the perception figures (perception
+// = lidar | lidar_camera): the first scan the stack processed after
+// [sim] snapshot_time. Everything in the base frame at the scan's end.
+struct PerceptionSnapshot {
+  double t = 0.0;  // s, the scan's reference time
+  struct Point {
+    float x, y, z;
+    std::uint8_t label;  // 0 ground, 1 non-ground, 2 cone
+  };
+  std::vector<Point> points;
+  std::vector<Cone> detected;  // what perception delivered
+  std::vector<Cone> truth;     // the true cones within 40 m
+  // the camera frame fused with that scan (lidar_camera), if any
+  bool camera = false;
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgb;
+  struct Box {
+    double x_min, y_min, x_max, y_max;
+    ConeColor color;
+  };
+  std::vector<Box> boxes;
+  std::vector<Vec2> projected;  // cluster centres the camera coloured or left to the LiDAR, px
+  std::vector<Vec2> dropped;    // cluster centres fusion dropped, px
+};
+
 struct RunResult {
   events::Result event;
   PlanSnapshot plan;
@@ -76,6 +103,7 @@ struct RunResult {
   std::string fault;       // the stack's last fault, if any
   int cycles = 0;          // control cycles run
   PerceptionMetrics perception;  // the stack's perceived cones against the truth, per range bin
+  std::optional<PerceptionSnapshot> snapshot;
 };
 
 // the mission the car is given for an event on a track (planner = oracle: also
