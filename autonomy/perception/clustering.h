@@ -12,8 +12,9 @@
 //
 // Distances are taken in the ground plane (x, y of the base frame): a cone is
 // upright, so its returns at different heights share its footprint, while
-// the rings that hit a distant cone lie far apart in height (0.35 m between
-// two 1 deg rings at 20 m), which a 3D distance would split. The tolerance
+// the rings that hit a distant cone lie far apart in height (0.17 m between
+// two 0.5 deg rings at 20 m, 0.35 m for 1 deg), which a 3D distance would
+// split. The tolerance
 // sits between the largest gap inside one cone's returns (two columns at
 // 20 m: 20 m x 6.1 mrad = 0.12 m) and the smallest gap between two cones
 // (centres >= 1.5 m apart on a track, minus two base radii: ~1.2 m).
@@ -39,9 +40,10 @@ struct ClusteringParams {
   // clusters with fewer points are dropped here (the cone filter applies
   // the real, range-dependent count test)
   int min_points = 1;  // -, >= 1
-  // clusters with more points are no cones (a small cone at 1 m gets ~300,
-  // a big one ~600): dropped before the costlier stages
-  int max_points = 1500;  // -, >= min_points
+  // clusters with more points are no cones (with the default 0.5 deg
+  // sensor a small cone at 1 m gets ~800, a big one ~1150, and nearer than
+  // that a cone stands under the nose): dropped before the costlier stages
+  int max_points = 2000;  // -, >= min_points
 };
 
 // "" when every field is usable, else the first problem, starting with the

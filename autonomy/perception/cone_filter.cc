@@ -35,6 +35,12 @@ std::string validate(const ConeFilterParams& p) {
     os << "reconstruction_radius must be finite and > 0 m (got " << p.reconstruction_radius << ")";
   } else if (!finite(p.reconstruction_margin) || !(p.reconstruction_margin >= 0.0)) {
     os << "reconstruction_margin must be finite and >= 0 m (got " << p.reconstruction_margin << ")";
+  } else if (!finite(p.local_ground_inner) || !(p.local_ground_inner >= 0.0)) {
+    os << "local_ground_inner must be finite and >= 0 m (got " << p.local_ground_inner << ")";
+  } else if (!finite(p.local_ground_outer) || !(p.local_ground_outer > p.local_ground_inner)) {
+    os << "local_ground_outer must be finite and > local_ground_inner m (got " << p.local_ground_outer << ")";
+  } else if (p.local_ground_min_points < 1) {
+    os << "local_ground_min_points must be >= 1 (got " << p.local_ground_min_points << ")";
   } else if (p.min_points < 1) {
     os << "min_points must be >= 1 (got " << p.min_points << ")";
   } else if (!finite(p.max_extent) || !(p.max_extent > 0.0)) {
@@ -92,9 +98,14 @@ ConeFilterStats ConeFilter::filter(Cloud& cloud, const GroundSegmenter& ground,
       candidates_.push_back(static_cast<std::uint32_t>(i));
     }
   }
-  std::sort(candidates_.begin(), candidates_.end(), [&pts](std::uint32_t a, std::uint32_t b) {
+  const auto x_order = [&pts](std::uint32_t a, std::uint32_t b) {
     return pts[a].x < pts[b].x || (pts[a].x == pts[b].x && a < b);
-  });
+  };
+  std::sort(candidates_.begin(), candidates_.end(), x_order);
+  ground_by_x_.clear();
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    if (pts[i].label == PointLabel::Ground) ground_by_x_.push_back(static_cast<std::uint32_t>(i));
+  std::sort(ground_by_x_.begin(), ground_by_x_.end(), x_order);
   const auto by_x = [&pts](std::uint32_t i, double x) { return pts[i].x < x; };
 
   const double rr2 = p.reconstruction_radius * p.reconstruction_radius;
@@ -111,7 +122,22 @@ ConeFilterStats ConeFilter::filter(Cloud& cloud, const GroundSegmenter& ground,
     const double cn = static_cast<double>(clusters.offsets[k + 1] - clusters.offsets[k]);
     mx /= cn;
     my /= cn;
-    const double g = ground.ground_height(mx, my);
+    double g = ground.ground_height(mx, my);
+    {
+      // the local ground: the median of the ground returns around the axis
+      local_z_.clear();
+      const double r0 = p.local_ground_inner * p.local_ground_inner, r1 = p.local_ground_outer * p.local_ground_outer;
+      auto gi = std::lower_bound(ground_by_x_.begin(), ground_by_x_.end(), mx - p.local_ground_outer, by_x);
+      for (; gi != ground_by_x_.end() && pts[*gi].x <= mx + p.local_ground_outer; ++gi) {
+        const double dx = pts[*gi].x - mx, dy = pts[*gi].y - my, d2 = dx * dx + dy * dy;
+        if (d2 >= r0 && d2 <= r1) local_z_.push_back(pts[*gi].z);
+      }
+      if (static_cast<int>(local_z_.size()) >= p.local_ground_min_points) {
+        auto mid = local_z_.begin() + static_cast<std::ptrdiff_t>(local_z_.size() / 2);
+        std::nth_element(local_z_.begin(), mid, local_z_.end());
+        g = *mid;
+      }
+    }
 
     // reconstruction: ground returns in the cylinder, above the margin
     auto it = std::lower_bound(candidates_.begin(), candidates_.end(), mx - p.reconstruction_radius, by_x);

@@ -53,7 +53,16 @@ struct ConeFilterParams {
   // reconstruction: a big cone's base radius (0.1425 m) plus range noise
   double reconstruction_radius = 0.2;   // m, > 0
   double reconstruction_margin = 0.02;  // m, >= 0
-  // count floor: two returns (a small cone at 15 m gets 2-3 on one ring)
+  // the ground under a cone: the median height of the ground returns in the
+  // ring [local_ground_inner, local_ground_outer] around its axis, when there
+  // are at least local_ground_min_points of them (else the region's plane,
+  // which on a bumpy ground can be off by the bumps: a small cone's 0.325 m
+  // would then pass for a big cone's 0.42 m)
+  double local_ground_inner = 0.25;  // m, >= 0
+  double local_ground_outer = 1.0;   // m, > local_ground_inner
+  int local_ground_min_points = 4;   // -, >= 1
+  // count floor: two returns (a small cone gets ~5 on three rings at 15 m,
+  // ~2 on two at 20 m with the default 0.5 deg sensor)
   int min_points = 2;  // -, >= 1
   // size
   double max_extent = 0.45;  // m, > 0
@@ -114,6 +123,8 @@ class ConeFilter {
   LidarCalibration calib_;
   double res_v_ = 0.0, res_h_ = 0.0;  // rad
   std::vector<std::uint32_t> candidates_;  // scratch: ground returns that may be re-added, by x
+  std::vector<std::uint32_t> ground_by_x_;  // scratch: every ground return, by x
+  std::vector<float> local_z_;              // scratch: the ground heights around one cone
 };
 
 }  // namespace paddock::perception

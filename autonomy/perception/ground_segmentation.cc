@@ -32,6 +32,8 @@ std::string validate(const GroundSegmentationParams& p) {
     os << "ground_threshold must be finite and > 0 m (got " << p.ground_threshold << ")";
   } else if (!finite(p.fit_window) || !(p.fit_window >= p.ground_threshold)) {
     os << "fit_window must be finite and >= ground_threshold m (got " << p.fit_window << ")";
+  } else if (!finite(p.first_fit_window) || !(p.first_fit_window >= p.ground_threshold)) {
+    os << "first_fit_window must be finite and >= ground_threshold m (got " << p.first_fit_window << ")";
   } else if (p.fit_iterations < 1 || p.fit_iterations > 100) {
     os << "fit_iterations must be in [1, 100] (got " << p.fit_iterations << ")";
   } else if (p.min_fit_points < 3) {
@@ -121,14 +123,16 @@ GroundSegmenter::Plane GroundSegmenter::fit_region(const Cloud& cloud, std::size
   // where the region meets the one inside it (the sensor for the innermost)
   const double jx = calib_.mount_x + r_inner * std::cos(azimuth);
   const double jy = calib_.mount_y + r_inner * std::sin(azimuth);
-  const double spread = r_inner > 0.0 ? params_.slope_prior_spread : params_.first_slope_prior_spread;
+  const bool innermost = !(r_inner > 0.0);
+  const double spread = innermost ? params_.first_slope_prior_spread : params_.slope_prior_spread;
+  const double first_window = innermost ? params_.first_fit_window : params_.fit_window;
   const double lambda = spread * spread;
   const int iters = params_.fit_iterations;
   Plane plane = prior;
   for (int it = 0; it < iters; ++it) {
     // the window shrinks geometrically from fit_window to ground_threshold
     const double f = iters == 1 ? 1.0 : static_cast<double>(it) / (iters - 1);
-    const double window = params_.fit_window * std::pow(params_.ground_threshold / params_.fit_window, f);
+    const double window = first_window * std::pow(params_.ground_threshold / first_window, f);
     // moments of the candidates near the current plane
     double n = 0.0, sx = 0.0, sy = 0.0, sz = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0, sxz = 0.0, syz = 0.0;
     for (std::uint32_t m = offsets_[region]; m < offsets_[region + 1]; ++m) {
@@ -161,8 +165,10 @@ GroundSegmenter::Plane GroundSegmenter::fit_region(const Cloud& cloud, std::size
     cand.c = mz - cand.a * mx - cand.b * my;
     // continuity: where the regions meet and where the candidates lie (a
     // few cone returns alone must not lift a plane to their own height)
+    // (the innermost region's prior, the level ground under the car, holds
+    // at the sensor only: there the slope bound does the centroid's part)
     if (!(std::abs(cand.at(jx, jy) - prior.at(jx, jy)) <= params_.max_step) ||
-        !(std::abs(cand.at(mx, my) - prior.at(mx, my)) <= params_.max_step)) {
+        (!innermost && !(std::abs(cand.at(mx, my) - prior.at(mx, my)) <= params_.max_step))) {
       break;
     }
     plane = cand;

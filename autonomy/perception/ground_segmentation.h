@@ -23,15 +23,16 @@
 // squares) to its stage-1 ground candidates near the plane of the region
 // inside it (the prior; for the innermost region the ground under the car, z =
 // 0 of the base frame). The fit is iterated fit_iterations times with a window
-// shrinking geometrically from fit_window to ground_threshold, which drops
+// shrinking geometrically from fit_window (first_fit_window for the innermost
+// region) to ground_threshold, which drops
 // cone returns and other outliers. A region seen by a single ring is an arc:
 // its radial slope is unobservable, so the slope is pulled toward the
 // prior's (a ridge term: the slope error along a direction is weighted by the
 // points' variance there, the prior's by slope_prior_spread^2, or
 // first_slope_prior_spread^2 for the innermost region). A fit steeper than
 // max_slope keeps the prior's slope; a fit off the prior by more than
-// max_step where the regions meet or at its candidates' centroid is
-// discarded for the prior; a region with fewer than min_fit_points
+// max_step where the regions meet or at its candidates' centroid (the
+// innermost region: at the sensor only) is discarded for the prior; a region with fewer than min_fit_points
 // candidates takes the prior. A point is ground when it is not vertical and
 // lies less than ground_threshold above its region's plane (below it counts
 // as ground).
@@ -54,16 +55,19 @@ struct GroundSegmentationParams {
   double max_slope = 0.25;  // -, > 0
   // added to the expected gap: two returns' horizontal ranges differ by
   // noise too (range noise sigma 2 cm: 2.8 cm on a difference). It matters
-  // for this low sensor, whose upper rings expect only ~4 cm on the steepest
-  // ground, no more than a cone's own slope and noise put between two rings
+  // for this low sensor, whose 0.5 deg rings expect only 1 - 2 cm on the
+  // steepest ground beyond 2 m, no more than a cone's own slope and noise put
+  // between two rings
   double gap_noise = 0.06;  // m, >= 0
   // a run of close returns rising by more than this is a vertical object: a
-  // cone at 5 m spans 0.087 m between two 1 deg rings; the ground's range
-  // noise moves near returns by millimetres in height
+  // small cone at 10 m still takes three 0.5 deg rings, 0.17 m from the
+  // lowest to the highest; the ground's range noise moves near returns by
+  // millimetres in height
   double vertical_threshold = 0.05;  // m, > 0
   // region boundaries (ascending ranges from the sensor): the ground's rings
-  // of a 0.15 m high sensor lie at 0.5 .. 2.1 m (-16 .. -4 deg), 2.9, 4.3 and
-  // 8.6 m; beyond that only uphill ground returns
+  // of a 0.15 m high sensor (-8 .. -0.5 deg, 0.5 deg apart) lie at 1.07 ..
+  // 1.91 m (eight rings), 2.1, 2.5, 2.9, 3.4, 4.3, 5.7, 8.6 and 17.2 m;
+  // beyond that only uphill ground returns
   std::vector<double> region_bounds{2.0, 4.0, 6.0, 9.0, 13.0, 20.0};  // m
   // azimuth sectors: 32 make a region about 1.7 m wide at 8.6 m, narrow
   // enough for 0.1 m bumps of a 10 m wavelength
@@ -75,6 +79,11 @@ struct GroundSegmentationParams {
   // the first fit takes candidates within this of the prior plane: below
   // the 0.15 m at which the ring level with the sensor hits every cone
   double fit_window = 0.1;  // m, >= ground_threshold
+  // the innermost region's first window: its prior, the level ground under
+  // the car, holds at the sensor only, and the lowest ring meets the ground
+  // ~1.1 m away, where a 10 % slope with bumps (up to ~0.16) already lifts
+  // it 0.17 m
+  double first_fit_window = 0.25;  // m, >= ground_threshold
   int fit_iterations = 3;    // -, >= 1
   // fewer candidates than this: the region takes the prior plane. A ground
   // ring crosses a 32-sector region in 32 columns; a cone gives a region
@@ -85,9 +94,12 @@ struct GroundSegmentationParams {
   // and its returns spread over metres: a weak pull finds a 10 % slope. An
   // outer region's prior is its inner neighbour's fitted plane, and the
   // region often holds one ring's arc plus a few cone-base returns whose
-  // leverage would tilt a free fit: a stronger pull
+  // leverage would tilt a free fit: a stronger pull. 0.6 m: the -1 deg
+  // ring's region (6 - 9 m) is extrapolated to the -0.5 deg ring at 17 m,
+  // where a 0.01 slope error is already 0.09 m of height (0.3 m let cone
+  // returns at 7 m tilt it that much, 0.8 m no longer follows 0.1 m bumps)
   double first_slope_prior_spread = 0.1;  // m, > 0
-  double slope_prior_spread = 0.3;        // m, > 0
+  double slope_prior_spread = 0.6;        // m, > 0
   // a fit whose height differs from the prior's by more than this where it
   // meets the inner region or at its candidates' centroid is discarded
   double max_step = 0.08;  // m, > 0

@@ -21,6 +21,8 @@ std::string validate(const IntensityColourParams& p) {
     os << "layer_height must be finite and > 0 m (got " << p.layer_height << ")";
   } else if (p.min_layers < 3) {
     os << "min_layers must be >= 3 (got " << p.min_layers << ")";
+  } else if (!finite(p.min_height)) {
+    os << "min_height must be finite m (got " << p.min_height << ")";
   } else if (p.min_points < 1) {
     os << "min_points must be >= 1 (got " << p.min_points << ")";
   } else if (!finite(p.min_span) || !(p.min_span >= 0.0)) {
@@ -49,6 +51,7 @@ ConeColor IntensityColourClassifier::classify(const Cloud& cloud, const std::uin
   samples_.clear();
   for (std::size_t k = 0; k < n; ++k) {
     const CloudPoint& p = cloud.points[members[k]];
+    if (!(p.height >= params_.min_height)) continue;
     const double layer = std::floor(static_cast<double>(p.height) / params_.layer_height);
     if (!(std::abs(layer) < 1e6)) continue;
     samples_.emplace_back(static_cast<int>(layer), p.intensity);

@@ -2,7 +2,8 @@
 // a cone's colour from its LiDAR intensity profile (paper section "Lidar
 // Perception"; ORACLES.md "Cones and LiDAR"). A blue cone carries a white
 // middle stripe, so its returns' intensity peaks mid-height; a yellow cone a
-// black one, so its intensity dips there. The returns are cut into layers
+// black one, so its intensity dips there. The returns (less those below
+// min_height: ground) are cut into layers
 // of layer_height by their height above the ground, each layer gives its
 // median intensity, and a least-squares parabola I(z) = a z^2 + b z + c
 // through the layers' (mean height, median intensity) decides:
@@ -15,8 +16,10 @@
 // show between layers above and below it). A cone whose top return reaches
 // big_cone_height is BigOrange (only big orange cones are that tall).
 //
-// The layers need rings: a 32-channel 1 deg sensor 0.15 m above the ground
-// puts 3 rings on a small cone out to ~6 m only; beyond, a cone is Unknown.
+// The layers need rings: the default 32-channel sensor (0.5 deg over -8 ..
+// +7.5 deg) 0.15 m above the ground puts three rings on a small cone out to
+// ~11 m, one of them (0 deg) always at 0.15 m, inside the stripe (a 1 deg
+// layout puts only two there beyond ~8 m: Unknown).
 //
 // No I/O, no clock, no global state; the classifier keeps scratch buffers.
 #include <cstddef>
@@ -35,6 +38,15 @@ struct IntensityColourParams {
   // a layer of its own when the rings are dense enough
   double layer_height = 0.03;  // m, > 0
   int min_layers = 3;          // -, >= 3 (a parabola)
+  // returns lower than this above the ground are left out: the ground
+  // return just in front of a cone joins the cone's vertical run in the
+  // ground segmentation (its gap to the cone's lowest return is within the
+  // expected gap + gap_noise), and its near-zero intensity at the bottom of
+  // a yellow cone would read as a blue cone's dark base. Its height is
+  // ~0 (the ground plane's error, ~1 cm); a cone's lowest ring may hit only
+  // 1 - 2 cm up (a 1 deg layout's -1 deg ring at 7 - 8 m), which 0.02 would
+  // lose
+  double min_height = 0.01;    // m
   int min_points = 4;          // -, >= 1
   double min_span = 0.1;       // m, >= 0: from the lowest to the highest layer
   // |a| below this (normalised intensity per m^2) is no curvature: a stripe

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sim/sensors/gaussian_table.h"
 #include "sim/sensors/param_check.h"
 
 namespace paddock::sensors {
@@ -34,14 +35,6 @@ const Rgb& albedo(const CameraParams& p, LidarMaterial m) {
     case LidarMaterial::Ground: return p.ground;
   }
   return p.grey;
-}
-
-// splitmix64: a small, fast, seedable stream for the per-channel pixel noise
-std::uint64_t splitmix(std::uint64_t& s) {
-  std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
 }
 
 constexpr float kNear = 1e-3f;          // m, near plane for the boxes' projection
@@ -149,18 +142,13 @@ Camera::Camera(const CameraParams& params, std::uint64_t seed)
   stamp_.assign(w * h, 0);
   cover_.assign(w * h, 0);
   reach_.assign(w * h, 0.0f);
-  // the noise table: the quantiles Phi^-1((k + 0.5) / 4096) (bisection on
-  // Phi(z) = erfc(-z / sqrt 2) / 2), times pixel_noise, rounded to levels
+  // the noise table: the quantiles of N(0, 1) (gaussian_table.h) times
+  // pixel_noise, rounded to levels
   if (params_.pixel_noise > 0.0) {
-    noise_.resize(4096);
-    for (std::size_t k = 0; k < noise_.size(); ++k) {
-      const double q = (static_cast<double>(k) + 0.5) / static_cast<double>(noise_.size());
-      double lo = -8.0, hi = 8.0;
-      for (int it = 0; it < 48; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (0.5 * std::erfc(-mid / std::sqrt(2.0)) < q ? lo : hi) = mid;
-      }
-      noise_[k] = static_cast<std::int16_t>(std::lround(params_.pixel_noise * 0.5 * (lo + hi)));
+    const auto& q = gaussian_quantiles();
+    noise_.resize(q.size());
+    for (std::size_t k = 0; k < q.size(); ++k) {
+      noise_[k] = static_cast<std::int16_t>(std::lround(params_.pixel_noise * q[k]));
     }
   }
 }
@@ -549,20 +537,12 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   }
 
   // pixel noise: per channel a 12-bit uniform draw picks one of the 4096
-  // quantiles of N(0, pixel_noise^2) (noise_ table; five draws per 64-bit
-  // word of a splitmix64 stream seeded from rng_ once a frame)
+  // quantiles of N(0, pixel_noise^2) (noise_ table; a GaussianStream seeded
+  // from rng_ once a frame: five draws per 64-bit word)
   if (!noise_.empty()) {
-    std::uint64_t s = rng_();
-    std::uint64_t r = 0;
-    int left = 0;
+    GaussianStream draws(rng_());
     for (std::uint8_t& byte : out.rgb) {
-      if (left == 0) {
-        r = splitmix(s);
-        left = 5;
-      }
-      const int v = byte + noise_[r & 0xFFFu];
-      r >>= 12;
-      --left;
+      const int v = byte + noise_[draws.index()];
       byte = static_cast<std::uint8_t>(std::clamp(v, 0, 255));
     }
   }

@@ -120,8 +120,9 @@ struct CameraParams {
   Rgb white{0.95, 0.95, 0.95};
   Rgb black{0.06, 0.06, 0.06};
   Rgb grey{0.50, 0.50, 0.50};  // cones of unknown colour
-  // Gaussian pixel noise std, per channel, in 8-bit levels, drawn from a
-  // table of 4096 quantiles (so cut at 3.4 sigma, rounded to whole levels);
+  // Gaussian pixel noise std, per channel, in 8-bit levels, drawn from the
+  // table of 4096 quantiles of gaussian_table.h (so cut at 3.67 sigma),
+  // rounded to whole levels;
   // 0 = off (the default: the annotation detector does not look at the
   // pixels, and noise costs about 2 ms a frame at 800 x 500)
   double pixel_noise = 0.0;  // levels, in [0, 64]

@@ -5,6 +5,8 @@
 #include <limits>
 #include <sstream>
 
+#include "sim/sensors/gaussian_table.h"
+
 namespace paddock::sensors {
 
 namespace {
@@ -401,6 +403,8 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
 
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
+  // the range and intensity noise's N(0, 1) draws (see the header)
+  GaussianStream normal(rng_());
 
   for (int c = 0; c < params_.columns; ++c) {
     const TimeNs t = column_time(start, c);
@@ -452,7 +456,7 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
         if (drops && uniform_(rng_) < params_.dropout) continue;
         const double r_true = static_cast<double>(rh.ray.tfar[j]);  // |dir| = 1: tfar is the range
         double r = r_true;
-        if (noisy) r += params_.range_noise * normal_(rng_);
+        if (noisy) r += params_.range_noise * normal();
         if (r < params_.range_min || r > params_.range_max) continue;
 
         // intensity: material at the true hit point, incidence on the facet
@@ -469,7 +473,7 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
                      : 0.0;
         const double q = params_.intensity_range_ref / std::max(r_true, 1e-9);
         double intensity = rho * cos_inc * std::min(1.0, q * q);
-        if (inoisy) intensity += params_.intensity_noise * normal_(rng_);
+        if (inoisy) intensity += params_.intensity_noise * normal();
         intensity = std::clamp(intensity, 0.0, 1.0);
 
         LidarPoint p;

@@ -25,6 +25,11 @@
 // extended Lambertian target that fills the beam (a cone face or the ground at
 // these ranges); below intensity_range_ref the receiver is taken as saturated.
 //
+// Noise: the range and intensity noise N(0, sigma^2) are table draws
+// (gaussian_table.h: 4096 quantiles of N(0, 1), cut at 3.67 sigma, std
+// within 0.02 % of 1) from a splitmix64 stream seeded once a scan from the
+// sensor's own std::mt19937_64; the dropout draws come from the latter.
+//
 // Knocked cones lie on their side (LidarWorld's `knocked`).
 //
 // Ground (GroundParams): z = ground_height(g, x, y) in the world frame. Flat
@@ -52,11 +57,23 @@ namespace paddock::sensors {
 
 struct LidarParams {
   // channels, evenly spaced in elevation from elevation_min to elevation_max
-  // (both included). 32 channels over -16 .. +15 deg: a 1 deg vertical
-  // resolution, a common 32-beam FS LiDAR layout.
+  // (both included). 32 channels over -8 .. +7.5 deg: a 0.5 deg vertical
+  // resolution, with a channel level with the optical centre (channel 16,
+  // 0 deg). The beams go where the cones are: seen from 0.15 m above the
+  // ground a small cone (0.325 m) 1 m ahead spans -8.5 .. +9.9 deg, one 5 m
+  // ahead -1.7 .. +2.0 deg, 10 m ahead -0.9 .. +1.0 deg; a 1 deg fan over
+  // -16 .. +15 deg puts only two rings on it beyond ~8 m, too few for the
+  // intensity profile's parabola (autonomy/perception/intensity_colour.h),
+  // this one three out to ~11 m (four out to ~7 m). The lowest ring meets
+  // the ground 1.07 m ahead; a cone closer than ~1.3 m loses its top. What
+  // the layout resembles: the 0.33 - 0.5 deg band around the horizon of a
+  // Velodyne VLP-32C or Hesai Pandar40P (-6 .. +2 deg at 0.33 deg, coarser
+  // outside) spread evenly over a narrow field, like a narrow-FoV 32-beam
+  // unit (an Ouster OS2-32: 22.5 deg, 0.7 deg uniform), not the 40 deg
+  // fans that waste half their beams on the sky and the car's own nose.
   int channels = 32;                               // -, in [1, 65535]
-  double elevation_min = -16.0 * kPi / 180.0;      // rad
-  double elevation_max = 15.0 * kPi / 180.0;       // rad
+  double elevation_min = -8.0 * kPi / 180.0;       // rad
+  double elevation_max = 7.5 * kPi / 180.0;        // rad
   // columns per rotation: 1024 gives a 6.1 mrad horizontal resolution
   int columns = 1024;  // -
   // rotation rate; DESIGN.md's LiDAR rate
@@ -257,7 +274,6 @@ class Lidar {
  private:
   LidarParams params_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
   std::uniform_real_distribution<double> uniform_{0.0, 1.0};
   // per channel: cos and sin of the elevation; per column: of the azimuth
   std::vector<double> cos_el_, sin_el_, cos_az_, sin_az_;
