@@ -114,6 +114,10 @@ void Stack::add_to_map(const hal::ConeDetections& d) {
 void Stack::learn_gates(const Pose2& pose) {
   if (trajectory_.empty()) return;
   const MissionParams& mp = params_.mission;
+  // a learned gate whose posts the map no longer holds as big cones is
+  // forgotten (and a better one may be learned in its place)
+  for (std::size_t i = gates_.size(); i-- > spec_.gates.size();)
+    if (!gate_still_seen(gates_[i])) gates_.erase(gates_.begin() + static_cast<std::ptrdiff_t>(i));
   for (const Segment& g : find_gates(cone_map_.cones(mp.gate_min_observations), params_.gates)) {
     const Vec2 mid = (g.a + g.b) * 0.5;
     bool known = false;
@@ -194,10 +198,24 @@ void Stack::start_stopping(TimeNs now, double speed) {
   stop_speed_ = std::max(speed, 0.0);
 }
 
+bool Stack::gate_still_seen(const Segment& g) const {
+  // the map still shows this gate (posts from its big orange cones, as it
+  // was learned): a gate learned from cones the map later saw as small (their
+  // early sightings misjudged their size) is no gate
+  for (const Segment& k : find_gates(cone_map_.cones(params_.mission.gate_min_observations), params_.gates)) {
+    if ((distance(k.a, g.a) < 0.5 && distance(k.b, g.b) < 0.5) || (distance(k.a, g.b) < 0.5 && distance(k.b, g.a) < 0.5))
+      return true;
+  }
+  return false;
+}
+
 void Stack::count_crossings(Vec2 base, TimeNs now, double speed) {
   if (last_base_position_) {
-    for (const Segment& g : gates_) {
+    for (std::size_t i = 0; i < gates_.size(); ++i) {
+      const Segment& g = gates_[i];
       if (!crossing_right_to_left(*last_base_position_, base, g)) continue;
+      // a learned gate must still be one when the car crosses it
+      if (i >= spec_.gates.size() && !gate_still_seen(g)) continue;
       // a line marked twice, or two gates close together, count once
       if (driven_ - last_crossing_at_ < params_.mission.gate_refractory_distance) continue;
       last_crossing_at_ = driven_;

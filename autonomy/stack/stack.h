@@ -150,6 +150,7 @@ class Stack {
   void plan(const hal::StateEstimate& st);
   void learn_gates(const Pose2& pose);
   void count_crossings(Vec2 base, TimeNs now, double speed);
+  bool gate_still_seen(const Segment& g) const;
   void start_stopping(TimeNs now, double speed);
   hal::ActuatorCommand safe_stop(TimeNs now, const std::string& reason);
 

@@ -190,11 +190,14 @@ std::string plan_json(const RunResult& r) {
   Json edges = Json::array();
   for (const Segment& s : r.plan.triangulation) edges.push_back({s.a.x, s.a.y, s.b.x, s.b.y});
   Json cones = Json::array();
+  Json gates = Json::array();
+  for (const Segment& g : r.plan.gates) gates.push_back({g.a.x, g.a.y, g.b.x, g.b.y});
   for (const Cone& c : r.plan.mapped_cones) cones.push_back({c.position.x, c.position.y, std::string(cone_tag(c.color))});
   const Json j = {{"triangulation", edges},
                   {"midpoints", points(r.plan.midpoints)},
                   {"centreline", points(r.plan.centreline)},
                   {"mapped_cones", cones},
+                  {"gates", gates},
                   {"reference", points(r.plan.reference)}};
   return j.dump() + "\n";
 }

@@ -359,6 +359,7 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   }
   res.plan.centreline = plan.search.points;
   res.plan.mapped_cones = stack.cone_map().cones();
+  res.plan.gates = stack.gates();
   for (const TrajectoryPoint& p : stack.trajectory().points) res.plan.reference.push_back(p.position());
   for (const world::DooEvent& d : cones.doo_events()) {
     const Cone& c = cones.cone(d.cone);

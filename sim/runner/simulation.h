@@ -62,6 +62,7 @@ struct PlanSnapshot {
   std::vector<Vec2> midpoints;         // the candidate points: the edges' midpoints
   std::vector<Vec2> centreline;        // the points the search chose
   std::vector<Cone> mapped_cones;      // the stack's cone map at the end of the run
+  std::vector<Segment> gates;          // the timekeeping gates the stack knew or learned
   std::vector<Vec2> reference;         // the trajectory it drove last
 };
 
