@@ -98,14 +98,37 @@ ConeFilterStats ConeFilter::filter(Cloud& cloud, const GroundSegmenter& ground,
       candidates_.push_back(static_cast<std::uint32_t>(i));
     }
   }
-  const auto x_order = [&pts](std::uint32_t a, std::uint32_t b) {
+  std::sort(candidates_.begin(), candidates_.end(), [&pts](std::uint32_t a, std::uint32_t b) {
     return pts[a].x < pts[b].x || (pts[a].x == pts[b].x && a < b);
+  });
+  // the ground returns near enough to matter, binned (counting sort) into a
+  // square grid of cells local_ground_outer wide around the sensor, so the
+  // ring around a cone lies in the 3 x 3 cells around its own
+  const double cell = p.local_ground_outer;
+  const double half = kGroundGridRange + cell;
+  const int side = static_cast<int>(std::ceil(2.0 * half / cell));
+  const auto cell_of = [&](double x, double y) -> long {
+    const double u = (x - sx + half) / cell, v = (y - sy + half) / cell;
+    if (!(u >= 0.0 && v >= 0.0 && u < side && v < side)) return -1;
+    return static_cast<long>(u) * side + static_cast<long>(v);
   };
-  std::sort(candidates_.begin(), candidates_.end(), x_order);
-  ground_by_x_.clear();
-  for (std::size_t i = 0; i < pts.size(); ++i)
-    if (pts[i].label == PointLabel::Ground) ground_by_x_.push_back(static_cast<std::uint32_t>(i));
-  std::sort(ground_by_x_.begin(), ground_by_x_.end(), x_order);
+  ground_cell_start_.assign(static_cast<std::size_t>(side) * static_cast<std::size_t>(side) + 1, 0);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (pts[i].label != PointLabel::Ground) continue;
+    const long c = cell_of(pts[i].x, pts[i].y);
+    if (c >= 0) ++ground_cell_start_[static_cast<std::size_t>(c) + 1];
+  }
+  for (std::size_t c = 1; c < ground_cell_start_.size(); ++c) ground_cell_start_[c] += ground_cell_start_[c - 1];
+  ground_by_cell_.resize(ground_cell_start_.back());
+  {
+    std::vector<std::uint32_t>& fill = ground_fill_;
+    fill.assign(ground_cell_start_.begin(), ground_cell_start_.end() - 1);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (pts[i].label != PointLabel::Ground) continue;
+      const long c = cell_of(pts[i].x, pts[i].y);
+      if (c >= 0) ground_by_cell_[fill[static_cast<std::size_t>(c)]++] = static_cast<std::uint32_t>(i);
+    }
+  }
   const auto by_x = [&pts](std::uint32_t i, double x) { return pts[i].x < x; };
 
   const double rr2 = p.reconstruction_radius * p.reconstruction_radius;
@@ -127,10 +150,19 @@ ConeFilterStats ConeFilter::filter(Cloud& cloud, const GroundSegmenter& ground,
       // the local ground: the median of the ground returns around the axis
       local_z_.clear();
       const double r0 = p.local_ground_inner * p.local_ground_inner, r1 = p.local_ground_outer * p.local_ground_outer;
-      auto gi = std::lower_bound(ground_by_x_.begin(), ground_by_x_.end(), mx - p.local_ground_outer, by_x);
-      for (; gi != ground_by_x_.end() && pts[*gi].x <= mx + p.local_ground_outer; ++gi) {
-        const double dx = pts[*gi].x - mx, dy = pts[*gi].y - my, d2 = dx * dx + dy * dy;
-        if (d2 >= r0 && d2 <= r1) local_z_.push_back(pts[*gi].z);
+      const long c0 = cell_of(mx, my);
+      if (c0 >= 0) {
+        const long cu = c0 / side, cv = c0 % side;
+        for (long u = std::max(0L, cu - 1); u <= std::min<long>(side - 1, cu + 1); ++u) {
+          for (long v = std::max(0L, cv - 1); v <= std::min<long>(side - 1, cv + 1); ++v) {
+            const auto c = static_cast<std::size_t>(u * side + v);
+            for (std::uint32_t g_i = ground_cell_start_[c]; g_i < ground_cell_start_[c + 1]; ++g_i) {
+              const CloudPoint& q = pts[ground_by_cell_[g_i]];
+              const double dx = q.x - mx, dy = q.y - my, d2 = dx * dx + dy * dy;
+              if (d2 >= r0 && d2 <= r1) local_z_.push_back(q.z);
+            }
+          }
+        }
       }
       if (static_cast<int>(local_z_.size()) >= p.local_ground_min_points) {
         auto mid = local_z_.begin() + static_cast<std::ptrdiff_t>(local_z_.size() / 2);

@@ -123,7 +123,9 @@ class ConeFilter {
   LidarCalibration calib_;
   double res_v_ = 0.0, res_h_ = 0.0;  // rad
   std::vector<std::uint32_t> candidates_;  // scratch: ground returns that may be re-added, by x
-  std::vector<std::uint32_t> ground_by_x_;  // scratch: every ground return, by x
+  // scratch: the ground returns within kGroundGridRange of the sensor, by grid cell
+  static constexpr double kGroundGridRange = 40.0;  // m, beyond the clustering's reach
+  std::vector<std::uint32_t> ground_cell_start_, ground_by_cell_, ground_fill_;
   std::vector<float> local_z_;              // scratch: the ground heights around one cone
 };
 
