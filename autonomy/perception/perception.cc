@@ -41,6 +41,7 @@ const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
   last_.lidar = pipeline_.process(scan, &odometry_);
   last_.camera_used = false;
   last_.camera_note.clear();
+  last_.camera_stamp = 0;
   last_.detection = {};
   last_.fusion = {};
   hal::ConeDetections& out = last_.output;

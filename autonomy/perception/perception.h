@@ -51,7 +51,7 @@ struct PerceptionFrame {
   LidarResult lidar;
   bool camera_used = false;            // the scan was fused with a camera frame
   std::string camera_note;             // why not, when the mode has a camera
-  TimeNs camera_stamp = 0;
+  TimeNs camera_stamp = 0;             // the fused frame's exposure (camera_used), else 0
   DetectorResult detection;            // the camera frame's boxes (camera_used)
   FusionResult fusion;                 // per LiDAR candidate (camera_used)
   hal::ConeDetections output;
