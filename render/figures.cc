@@ -68,6 +68,8 @@ void widen(double& lo, double& hi) {
   }
 }
 
+}  // namespace
+
 // ---- the track map ----
 
 const char* cone_label(ConeColor c) {
@@ -81,8 +83,9 @@ const char* cone_label(ConeColor c) {
   return "unknown cone";
 }
 
-// the base radius of a cone (m): FS rules, small cones 228 mm across, big ones 285 mm
 double cone_radius(ConeColor c) { return c == ConeColor::BigOrange ? 0.1425 : 0.114; }
+
+namespace {
 
 bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 

@@ -111,6 +111,10 @@ struct TrackMapData {
 Figure draw_track_map(const TrackMapData& data, const FigureStyle& style);
 // the map's fill colour of a cone type (blue, yellow, small orange, big orange, unknown: grey)
 Rgba cone_color(ConeColor color);
+// the legend's name of a cone type ("blue cone", ..., "unknown cone")
+const char* cone_label(ConeColor color);
+// the base radius of a cone (m): FS rules, small cones 228 mm across, big ones 285 mm
+double cone_radius(ConeColor color);
 
 // ---- the controller data (the paper's "controller data" figure) ----
 

@@ -22,19 +22,6 @@ bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
 
 constexpr Rgba kNone{0, 0, 0, 0};  // no outline
 
-const char* cone_name(ConeColor c) {
-  switch (c) {
-    case ConeColor::Blue: return "blue cone";
-    case ConeColor::Yellow: return "yellow cone";
-    case ConeColor::SmallOrange: return "small orange cone";
-    case ConeColor::BigOrange: return "big orange cone";
-    case ConeColor::Unknown: break;
-  }
-  return "unknown cone";
-}
-
-// the base radius of a cone (m): FS rules, small cones 228 mm across, big ones 285 mm
-double base_radius(ConeColor c) { return c == ConeColor::BigOrange ? 0.1425 : 0.114; }
 
 // where the legend goes: a row above the plot (top px reserved between the
 // title and the plot), or a column right of it (side px reserved)
@@ -236,7 +223,7 @@ Figure draw_lidar_view(const LidarViewData& d, const FigureStyle& style) {
   }
 
   // the detected cones: green discs (a little larger than a cone) ringed in their colour
-  const double det_r = std::max(1.3 * base_radius(ConeColor::SmallOrange) * scale, page.px(3.2));
+  const double det_r = std::max(1.3 * cone_radius(ConeColor::SmallOrange) * scale, page.px(3.2));
   const double ring_w = std::max(1.0, page.px(1.0));
   for (const Cone& cone : d.detected) {
     if (!finite(cone.position)) continue;
@@ -292,7 +279,7 @@ Figure draw_camera_view(const CameraViewData& d, const FigureStyle& style) {
   for (ConeColor cc : {ConeColor::Blue, ConeColor::Yellow, ConeColor::SmallOrange, ConeColor::BigOrange,
                        ConeColor::Unknown}) {
     if (!present[static_cast<int>(cc)]) continue;
-    LegendEntry e{LegendEntry::Kind::Marker, cone_name(cc), cone_color(cc), kNone, 8.0, Marker::Square};
+    LegendEntry e{LegendEntry::Kind::Marker, cone_label(cc), cone_color(cc), kNone, 8.0, Marker::Square};
     e.hollow = true;
     legend.push_back(e);
   }

@@ -13,4 +13,15 @@ std::string_view cone_tag(ConeColor c) {
   return "unknown";
 }
 
+ConeColor look_alike(ConeColor c) {
+  switch (c) {
+    case ConeColor::Blue: return ConeColor::Yellow;
+    case ConeColor::Yellow: return ConeColor::Blue;
+    case ConeColor::SmallOrange: return ConeColor::BigOrange;
+    case ConeColor::BigOrange: return ConeColor::SmallOrange;
+    case ConeColor::Unknown: return ConeColor::Unknown;
+  }
+  return ConeColor::Unknown;
+}
+
 }  // namespace paddock

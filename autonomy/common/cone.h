@@ -18,4 +18,8 @@ struct Cone {
 // the track-file tag of a colour: blue, yellow, orange, big_orange, unknown
 std::string_view cone_tag(ConeColor c);
 
+// the colour a classifier mistakes it for: blue <-> yellow, small <-> big
+// orange (unknown stays unknown)
+ConeColor look_alike(ConeColor c);
+
 }  // namespace paddock

@@ -13,17 +13,6 @@ namespace {
 bool finite(double v) { return std::isfinite(v); }
 bool unit(double v) { return finite(v) && v >= 0.0 && v <= 1.0; }
 
-ConeColor confuse(ConeColor c) {
-  switch (c) {
-    case ConeColor::Blue: return ConeColor::Yellow;
-    case ConeColor::Yellow: return ConeColor::Blue;
-    case ConeColor::SmallOrange: return ConeColor::BigOrange;
-    case ConeColor::BigOrange: return ConeColor::SmallOrange;
-    case ConeColor::Unknown: return ConeColor::Unknown;
-  }
-  return c;
-}
-
 }  // namespace
 
 ConeDetector::~ConeDetector() = default;
@@ -162,7 +151,7 @@ DetectorResult AnnotationDetector::detect(const hal::CameraFrame& frame) {
     const bool by = b.color == ConeColor::Blue || b.color == ConeColor::Yellow;
     const bool orange = b.color == ConeColor::SmallOrange || b.color == ConeColor::BigOrange;
     if ((by && u_conf < params_.p_confuse_blue_yellow) || (orange && u_conf < params_.p_confuse_orange_size)) {
-      b.color = confuse(b.color);
+      b.color = look_alike(b.color);
     }
     const double sx = params_.box_jitter * w, sy = params_.box_jitter * h;
     double x0 = std::clamp(t.i_min + sx * e[0], 0.0, w_img), x1 = std::clamp(t.i_max + 1 + sx * e[1], 0.0, w_img);

@@ -33,18 +33,6 @@ std::string check(const Range& c) {
 
 constexpr double kInf = 1e300;  // "no upper bound" that still prints as a number
 
-// the wrong colour of a classifier that confuses the look-alikes
-ConeColor flipped(ConeColor c) {
-  switch (c) {
-    case ConeColor::Blue: return ConeColor::Yellow;
-    case ConeColor::Yellow: return ConeColor::Blue;
-    case ConeColor::SmallOrange: return ConeColor::BigOrange;
-    case ConeColor::BigOrange: return ConeColor::SmallOrange;
-    case ConeColor::Unknown: return ConeColor::Unknown;
-  }
-  return ConeColor::Unknown;
-}
-
 }  // namespace
 
 std::string validate(const ConeSensorParams& p) {
@@ -243,7 +231,7 @@ hal::ConeDetections ConeSensor::measure(const std::vector<Cone>& cones, const st
     if (u_unknown < p.unknown_color_probability + p.unknown_color_growth * q) {
       det.color = k.color == ConeColor::BigOrange ? ConeColor::BigOrange : ConeColor::Unknown;
     } else if (u_flip < p.color_flip_probability + p.color_flip_growth * q) {
-      det.color = flipped(k.color);
+      det.color = look_alike(k.color);
     }
     out.cones.push_back(det);
   }
