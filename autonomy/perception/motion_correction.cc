@@ -118,7 +118,7 @@ void MotionCorrector::correct(const hal::LidarScan& scan, const Odometry* odomet
       q.x = static_cast<float>(T.x + ct * bx - st * by);
       q.y = static_cast<float>(T.y + st * bx + ct * by);
       q.z = static_cast<float>(calib_.mount_z + zl);
-      q.range_xy = static_cast<float>(std::hypot(xl, yl));
+      q.range_xy = static_cast<float>(std::sqrt(xl * xl + yl * yl));
       q.z_sensor = static_cast<float>(zl);
       q.height = 0.0f;
       q.intensity = p.intensity;
