@@ -152,5 +152,60 @@ TEST(Stack, CountsFinishCrossingsThenStopsAndFinishes) {
   EXPECT_EQ(s.telemetry().fallbacks, 0);
 }
 
+// a straight corridor (blue left, yellow right) with a real timekeeping gate of
+// big orange cones at x = 10 and, at x = 30, a pair the perception first calls
+// big orange (from afar) and then, nearer, blue and yellow: the stack learns
+// both gates, but crosses only the first as one: by x = 30 its map holds the
+// second pair as small cones, so that gate is forgotten and not counted
+// (counted, it would be the autocross's finish and stop the car)
+TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
+  StackParams p;
+  p.modes.planner = PlannerMode::Delaunay;
+  MissionSpec m;
+  m.mission = Mission::Autocross;
+  m.finish_crossings = 2;
+  Stack s(p, m);
+  ScriptedHal hal;
+  std::vector<Cone> track;
+  for (double x = -6.0; x <= 70.0; x += 3.0) {
+    track.push_back({{x, 1.75}, ConeColor::Blue});
+    track.push_back({{x, -1.75}, ConeColor::Yellow});
+  }
+  track.push_back({{10.0, 2.6}, ConeColor::BigOrange});
+  track.push_back({{10.0, -2.6}, ConeColor::BigOrange});
+  const std::size_t fake_left = track.size();
+  track.push_back({{30.0, 2.6}, ConeColor::BigOrange});
+  track.push_back({{30.0, -2.6}, ConeColor::BigOrange});
+  const double v = 5.0;
+  int learned_max = 0;
+  for (int k = 0; k < 100 * 10; ++k) {
+    const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
+    const double x = k < 100 ? 0.0 : v * (k - 100) * 0.01;  // at rest for 1 s, then 5 m/s along +x
+    hal.inbox.push_back(state_at(t, {x, 0.0}, 0.0, k < 100 ? 0.0 : v));
+    if (k == 50) hal.inbox.push_back(hal::ResSignal{t, true, false});
+    if (k % 10 == 0) {
+      // a perception frame of the cones within 20 m ahead
+      hal::ConeDetections d;
+      d.stamp = t;
+      for (std::size_t i = 0; i < track.size(); ++i) {
+        const Vec2 rel = track[i].position - Vec2{x, 0.0};
+        if (rel.x < -2.0 || rel.x > 20.0) continue;
+        ConeColor c = track[i].color;
+        if (i >= fake_left && x > 16.0) c = i == fake_left ? ConeColor::Blue : ConeColor::Yellow;
+        d.cones.push_back({rel, c});
+      }
+      hal.inbox.push_back(d);
+    }
+    s.tick(t, hal);
+    learned_max = std::max(learned_max, static_cast<int>(s.gates().size()));
+    if (x > 45.0) break;
+  }
+  EXPECT_EQ(learned_max, 2);                   // both pairs were taken for gates at first
+  EXPECT_EQ(s.telemetry().finish_crossings, 1);  // only the real one counted
+  EXPECT_FALSE(s.telemetry().stopping);
+  ASSERT_EQ(s.gates().size(), 1u);
+  EXPECT_NEAR(0.5 * (s.gates()[0].a.x + s.gates()[0].b.x), 10.0, 0.1);
+}
+
 }  // namespace
 }  // namespace paddock::stack
