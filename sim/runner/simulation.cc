@@ -1,9 +1,10 @@
 #include "sim/runner/simulation.h"
 
 #include <chrono>
-#include <memory>
-#include <deque>
 #include <cmath>
+#include <deque>
+#include <memory>
+#include <optional>
 
 #include "sim/runner/raw_sensors.h"
 #include "sim/runner/sim_hal.h"
