@@ -5,7 +5,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
+
+#include <nlohmann/json.hpp>
 
 #include "render/figures.h"
 #include "sim/runner/files.h"
@@ -54,6 +58,39 @@ TEST(Plots, RunWithPlotsDrawsTheThreeFiguresAtTheDefaultSizes) {
   for (int y = 0; y < map.height; y += 4)
     for (int x = 0; x < map.width; x += 4) drawn += map.pixel(x, y) == bg ? 0 : 1;
   EXPECT_GT(drawn, 2000);
+}
+
+TEST(Plots, RawSensorRunsWriteThePerceptionSnapshotAndItsFigures) {
+  // lidar_camera: the snapshot (perception.json, camera.png) and both
+  // perception figures; the snapshot's camera image is the camera's size and
+  // its detections lie near true cones
+  const std::string dir = scratch("perception");
+  const auto o = paddock("run " + kRoot + "/scenarios/fsg_2023_trackdrive.ini --set event.timeout=10 --set sim.snapshot_time=8 --plots --out " + dir);
+  ASSERT_EQ(o.code, 0) << o.output;
+  EXPECT_THAT(o.output, HasSubstr(dir + "/lidar_view.png"));
+  EXPECT_THAT(o.output, HasSubstr(dir + "/camera_view.png"));
+  const render::Image cam = png_at(dir + "/camera.png");
+  EXPECT_EQ(cam.width, 800);
+  EXPECT_EQ(cam.height, 500);
+  EXPECT_EQ(png_at(dir + "/lidar_view.png").width, 1600);
+  const auto j = nlohmann::json::parse(read_file(dir + "/perception.json"));
+  EXPECT_NEAR(j.at("t").get<double>(), 8.0, 0.11);
+  ASSERT_GT(j.at("points").size(), 5000u);
+  ASSERT_GT(j.at("detected").size(), 5u);
+  for (const auto& d : j.at("detected")) {
+    double best = 1e9;
+    for (const auto& t : j.at("truth"))
+      best = std::min(best, std::hypot(d.at(0).get<double>() - t.at(0).get<double>(), d.at(1).get<double>() - t.at(1).get<double>()));
+    EXPECT_LT(best, 0.3);
+  }
+  EXPECT_GT(j.at("camera").at("boxes").size(), 3u);
+  // lidar alone: no camera, so no camera figure
+  const std::string lidar_dir = scratch("perception_lidar");
+  const auto l = paddock("run " + kRoot + "/scenarios/fsg_2023_trackdrive.ini --set autonomy.perception=lidar --set event.timeout=10 --set sim.snapshot_time=8 --plots --out " + lidar_dir);
+  ASSERT_EQ(l.code, 0) << l.output;
+  EXPECT_TRUE(fs::exists(lidar_dir + "/lidar_view.png"));
+  EXPECT_FALSE(fs::exists(lidar_dir + "/camera_view.png"));
+  EXPECT_FALSE(fs::exists(lidar_dir + "/camera.png"));
 }
 
 TEST(Plots, PlotRedrawsAFinishedRunWithOtherSizesAndTheSameFiles) {
