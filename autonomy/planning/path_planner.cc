@@ -4,6 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include "autonomy/common/polyline.h"
+
 namespace paddock::planning {
 
 namespace {
@@ -68,17 +70,29 @@ const char* to_string(PlanStatus s) {
 }
 
 PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, double speed,
-                     const PathPlannerParams& params) {
+                     const PathPlannerParams& params, bool lap) {
   PlanResult out;
   if (!triangulate_and_search(cone_map, vehicle, speed, params, out)) return out;
 
   // the raw centreline: a lap as found, an open path from the vehicle on
-  out.closed = out.search.closed;
-  if (!out.closed) {
-    const Vec2 car = vehicle.position();
-    if (distance(car, out.search.points.front()) > kSamePoint) out.centreline.push_back(car);
+  out.closed = out.search.closed && lap;
+  const Vec2 car = vehicle.position();
+  if (out.search.closed && !out.closed) {
+    // a lap not wanted as one: the open path along it from the vehicle, once
+    // around, ending before it comes back to the vehicle (its last points,
+    // within a search radius of the car, would overlap its beginning)
+    const std::vector<Vec2>& ring = out.search.points;
+    const std::size_t n = ring.size();
+    const std::size_t first = (project(ring, true, car).segment + 1) % n;
+    std::vector<Vec2> ahead;
+    for (std::size_t k = 0; k < n; ++k) ahead.push_back(ring[(first + k) % n]);
+    while (ahead.size() > 2 && distance(ahead.back(), car) < params.search.search_radius) ahead.pop_back();
+    if (distance(car, ahead.front()) > kSamePoint) out.centreline.push_back(car);
+    out.centreline.insert(out.centreline.end(), ahead.begin(), ahead.end());
+  } else {
+    if (!out.closed && distance(car, out.search.points.front()) > kSamePoint) out.centreline.push_back(car);
+    out.centreline.insert(out.centreline.end(), out.search.points.begin(), out.search.points.end());
   }
-  out.centreline.insert(out.centreline.end(), out.search.points.begin(), out.search.points.end());
   // a lap closes where it began: points at its end that overlap its first
   // step (past the first point, or on it) would fold the closed spline into
   // a cusp at the join

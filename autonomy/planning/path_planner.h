@@ -60,9 +60,13 @@ struct PlanResult {
 // A full lap (the search closes the loop) gives a closed trajectory with a
 // closed velocity profile. Otherwise the path is open: it starts at the
 // vehicle and ends at the last centreline point found, at speed 0, since the
-// car must be able to stop before the unknown. Never throws.
+// car must be able to stop before the unknown. With `lap` false a lap is not
+// wanted yet (a car that has not driven far enough for the search's lap to be
+// trusted as the circuit, e.g. a long-range sensor that already shows the
+// whole of it): a lap the search closes is planned as an open path along it
+// from the vehicle, once around, ending short of the vehicle. Never throws.
 PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, double speed,
-                     const PathPlannerParams& params = {});
+                     const PathPlannerParams& params = {}, bool lap = true);
 
 // the least-squares line through points: orthogonal (total) least squares,
 // the principal axis of the points' covariance

@@ -111,7 +111,12 @@ void Stack::add_to_map(const hal::ConeDetections& d) {
   map_news_ = true;
 }
 
-void Stack::learn_gates(const Pose2& pose) {
+namespace {
+// the spacing of the driven path's marks (m)
+constexpr double kPathMarkSpacing = 0.25;
+}  // namespace
+
+void Stack::learn_gates(const Pose2& pose, TimeNs now, double speed) {
   if (trajectory_.empty()) return;
   const MissionParams& mp = params_.mission;
   // a learned gate whose posts the map no longer holds as big cones is
@@ -122,8 +127,18 @@ void Stack::learn_gates(const Pose2& pose) {
     const Vec2 mid = (g.a + g.b) * 0.5;
     bool known = false;
     for (const Segment& k : gates_) known = known || distance((k.a + k.b) * 0.5, mid) < 3.0;
+    if (known) continue;
+    // a gate behind the car counts when the car drove through it since the
+    // last counted crossing (it came into view only after): oriented by the
+    // motion through it, and that crossing counted
+    if (dot(mid - pose.position(), pose.heading()) <= 0.0) {
+      if (const auto crossed = crossed_since_last(g, pose.position())) {
+        gates_.push_back(orient_gate(g, crossed->first));
+        count_crossing(crossed->second, now, speed);
+      }
+      continue;
+    }
     // a new gate lies across the path ahead, and is oriented by the heading of the car that sees it
-    if (known || dot(mid - pose.position(), pose.heading()) <= 0.0) continue;
     if (std::abs(project(trajectory_, mid, 0.0, 0.0).offset) > mp.gate_max_offset) continue;
     gates_.push_back(orient_gate(g, pose.heading()));
   }
@@ -164,7 +179,8 @@ void Stack::plan(const hal::StateEstimate& st) {
       spec_.mission == Mission::Acceleration
           ? planning::plan_acceleration(cones, st.pose, speed, params_.planner,
                                         std::max(10.0, mp.acceleration_length - driven_))
-          : planning::plan_path(cones, st.pose, speed, params_.planner);
+          : planning::plan_path(cones, st.pose, speed, params_.planner,
+                                driven_ >= mp.loop_closure_distance);
   ++telemetry_.plans;
   if (!res.ok()) {
     // hold the last trajectory; with none the car stays parked
@@ -172,13 +188,15 @@ void Stack::plan(const hal::StateEstimate& st) {
     telemetry_.last_fault = "planning: " + res.reason;
   } else if (res.closed) {
     // a closed centreline is the whole lap once the car has driven most of it;
-    // before that it is the search cutting across a map still being explored
+    // before that it may be the search cutting across a map still being
+    // explored (or a long-range map that already shows the whole circuit), so
+    // the planner gives the open path along it (plan_path's `lap`)
     const bool back_at_start =
         start_position_ && distance(st.pose.position(), *start_position_) < mp.loop_closure_radius;
-    if (driven_ >= mp.loop_closure_distance && (back_at_start || mp.loop_closure_radius <= 0.0)) {
+    if (back_at_start || mp.loop_closure_radius <= 0.0) {
       pending_lap_ = res.trajectory;
       telemetry_.lap_locked = spec_.mission == Mission::Trackdrive;
-    } else if (driven_ >= mp.loop_closure_distance) {
+    } else {
       // the search closes the loop from the car before the car is back at its
       // start: the path is good ahead, so drive it, and keep planning
       trajectory_ = res.trajectory;
@@ -188,7 +206,7 @@ void Stack::plan(const hal::StateEstimate& st) {
   }
   last_plan_ = std::move(res);
   last_plan_cones_ = cones;
-  if (spec_.gates.empty()) learn_gates(st.pose);
+  if (spec_.gates.empty()) learn_gates(st.pose, st.stamp, st.vx);
 }
 
 void Stack::start_stopping(TimeNs now, double speed) {
@@ -209,6 +227,34 @@ bool Stack::gate_still_seen(const Segment& g) const {
   return false;
 }
 
+bool Stack::count_crossing(double at, TimeNs now, double speed) {
+  // a line marked twice, or two gates close together, count once
+  if (at - last_crossing_at_ < params_.mission.gate_refractory_distance) return false;
+  last_crossing_at_ = at;
+  ++telemetry_.finish_crossings;
+  if (spec_.finish_crossings > 0 && telemetry_.finish_crossings >= spec_.finish_crossings) start_stopping(now, speed);
+  // the path before a counted crossing can count nothing more
+  path_marks_.clear();
+  return true;
+}
+
+std::optional<std::pair<Vec2, double>> Stack::crossed_since_last(const Segment& g, Vec2 base) const {
+  std::optional<std::pair<Vec2, double>> latest;
+  const Segment reversed{g.b, g.a};
+  for (std::size_t i = 0; i < path_marks_.size(); ++i) {
+    const Vec2 p0 = path_marks_[i].first;
+    const Vec2 p1 = i + 1 < path_marks_.size() ? path_marks_[i + 1].first : base;
+    const double d1 = i + 1 < path_marks_.size() ? path_marks_[i + 1].second : driven_;
+    if (distance(p0, p1) <= 0.0) continue;
+    std::optional<double> f = crossing_right_to_left(p0, p1, g);
+    if (!f) f = crossing_right_to_left(p0, p1, reversed);
+    if (!f) continue;
+    const double d0 = path_marks_[i].second;
+    if (d0 + *f * (d1 - d0) > last_crossing_at_) latest = std::make_pair(p1 - p0, d0 + *f * (d1 - d0));
+  }
+  return latest;
+}
+
 void Stack::count_crossings(Vec2 base, TimeNs now, double speed) {
   if (last_base_position_) {
     for (std::size_t i = 0; i < gates_.size(); ++i) {
@@ -216,14 +262,12 @@ void Stack::count_crossings(Vec2 base, TimeNs now, double speed) {
       if (!crossing_right_to_left(*last_base_position_, base, g)) continue;
       // a learned gate must still be one when the car crosses it
       if (i >= spec_.gates.size() && !gate_still_seen(g)) continue;
-      // a line marked twice, or two gates close together, count once
-      if (driven_ - last_crossing_at_ < params_.mission.gate_refractory_distance) continue;
-      last_crossing_at_ = driven_;
-      ++telemetry_.finish_crossings;
-      if (spec_.finish_crossings > 0 && telemetry_.finish_crossings >= spec_.finish_crossings) start_stopping(now, speed);
+      count_crossing(driven_, now, speed);
     }
   }
   last_base_position_ = base;
+  if (path_marks_.empty() || distance(path_marks_.back().first, base) >= kPathMarkSpacing)
+    path_marks_.emplace_back(base, driven_);
 }
 
 hal::ActuatorCommand Stack::safe_stop(TimeNs now, const std::string& reason) {

@@ -148,8 +148,15 @@ class Stack {
   std::optional<Pose2> pose_at(TimeNs t) const;
   // planner = delaunay: a new plan from the cone map when the map has news
   void plan(const hal::StateEstimate& st);
-  void learn_gates(const Pose2& pose);
+  void learn_gates(const Pose2& pose, TimeNs now, double speed);
   void count_crossings(Vec2 base, TimeNs now, double speed);
+  // counts a crossing made at driven distance `at` (m) unless it is within the
+  // refractory distance of the last one; true when counted
+  bool count_crossing(double at, TimeNs now, double speed);
+  // where the driven path crossed g since the last counted crossing (the
+  // latest such crossing): the motion's direction there and the driven
+  // distance (m)
+  std::optional<std::pair<Vec2, double>> crossed_since_last(const Segment& g, Vec2 base) const;
   bool gate_still_seen(const Segment& g) const;
   void start_stopping(TimeNs now, double speed);
   hal::ActuatorCommand safe_stop(TimeNs now, const std::string& reason);
@@ -176,6 +183,11 @@ class Stack {
   double driven_ = 0.0;                     // distance driven (m)
   std::optional<Vec2> start_position_;      // where the car began to drive
   double last_crossing_at_ = -1e9;          // driven_ at the last counted crossing (m)
+  // the base positions driven since the last counted crossing, with driven_
+  // at each (one every kPathMarkSpacing m): a gate first seen after the car
+  // crossed it (its cones beside the car at the start, out of the sensors'
+  // view) still counts
+  std::vector<std::pair<Vec2, double>> path_marks_;
   bool go_ = false;
   bool emergency_ = false;
   std::optional<TimeNs> last_tick_;

@@ -510,6 +510,31 @@ TEST(PathPlanner, ClosedLapHasAClosedProfile) {
   EXPECT_GT(plan.triangulation.edges.size(), 2 * t.cones.size());
 }
 
+// a lap the search closes before the car may take it for the circuit (the
+// stack's `lap` false: a long-range map already shows the whole of it early
+// in the first lap) is the open path along it from the car, once around,
+// ending at rest short of the car; before, the planner gave only the lap and
+// the stack held its last open path, which ended where the car then stopped
+TEST(PathPlanner, ALapNotWantedYetIsAnOpenPathAlongIt) {
+  const TrackFile t = read_track("fsg_2023");
+  const Pose2 start = start_pose(t);
+  const PlanResult lap = plan_path(t.cones, start, 5.0);
+  ASSERT_TRUE(lap.ok() && lap.closed) << lap.reason;
+  const PlanResult open = plan_path(t.cones, start, 5.0, PathPlannerParams{}, false);
+  ASSERT_TRUE(open.ok()) << open.reason;
+  EXPECT_FALSE(open.closed);
+  EXPECT_FALSE(open.trajectory.closed);
+  ASSERT_GE(open.centreline.size(), 3u);
+  EXPECT_EQ(open.centreline.front(), start.position());
+  // ahead of the car, and most of the lap long, ending short of the car at rest
+  EXPECT_GT(dot(open.centreline[1] - start.position(), start.heading()), 0.0);
+  EXPECT_GE(distance(open.centreline.back(), start.position()), PathPlannerParams{}.search.search_radius);
+  EXPECT_GT(open.trajectory.length, 0.8 * lap.trajectory.length);
+  EXPECT_LT(open.trajectory.length, lap.trajectory.length + 1.0);
+  EXPECT_NEAR(open.trajectory.points.back().speed, 0.0, 1e-9);
+  EXPECT_NEAR(open.trajectory.points.front().speed, 5.0, 0.5);
+}
+
 // ---- acceleration: the line fit ----------------------------------------------------------
 
 TEST(PathPlanner, FitLineIsTotalLeastSquares) {

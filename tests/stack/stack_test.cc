@@ -207,5 +207,58 @@ TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
   EXPECT_NEAR(0.5 * (s.gates()[0].a.x + s.gates()[0].b.x), 10.0, 0.1);
 }
 
+// acceleration: the start gate's big orange cones stand beside the parked car,
+// out of the perception's view (a low LiDAR's vertical field passes over
+// them, the camera looks ahead), and come into view only behind the car once
+// it has crossed them; the finish gate at x = 30 is seen ahead as usual. The
+// stack counts the start crossing when it learns that gate behind the car
+// from the path it drove, then the finish, and stops (the mission needs 2)
+TEST(Stack, AGateSeenOnlyAfterTheCarCrossedItCounts) {
+  StackParams p;
+  p.modes.planner = PlannerMode::Delaunay;
+  MissionSpec m;
+  m.mission = Mission::Acceleration;
+  m.finish_crossings = 2;
+  Stack s(p, m);
+  ScriptedHal hal;
+  std::vector<Cone> track;
+  for (double x = -6.0; x <= 90.0; x += 3.0) {
+    track.push_back({{x, 1.75}, ConeColor::Blue});
+    track.push_back({{x, -1.75}, ConeColor::Yellow});
+  }
+  const std::size_t start_left = track.size();
+  track.push_back({{0.0, 2.6}, ConeColor::BigOrange});
+  track.push_back({{0.0, -2.6}, ConeColor::BigOrange});
+  track.push_back({{30.0, 2.6}, ConeColor::BigOrange});
+  track.push_back({{30.0, -2.6}, ConeColor::BigOrange});
+  const double v = 5.0;
+  int crossings_at_10 = -1;
+  for (int k = 0; k < 100 * 12; ++k) {
+    const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
+    const double x = k < 100 ? -2.0 : -2.0 + v * (k - 100) * 0.01;  // at rest for 1 s, then 5 m/s along +x
+    hal.inbox.push_back(state_at(t, {x, 0.0}, 0.0, k < 100 ? 0.0 : v));
+    if (k == 50) hal.inbox.push_back(hal::ResSignal{t, true, false});
+    if (k % 10 == 0) {
+      hal::ConeDetections d;
+      d.stamp = t;
+      for (std::size_t i = 0; i < track.size(); ++i) {
+        const Vec2 rel = track[i].position - Vec2{x, 0.0};
+        // the start gate only from behind, everything else 3-20 m ahead
+        const bool seen = i == start_left || i == start_left + 1 ? rel.x < -1.0 && rel.x > -8.0
+                                                                 : rel.x > 3.0 && rel.x < 20.0;
+        if (seen) d.cones.push_back({rel, track[i].color});
+      }
+      hal.inbox.push_back(d);
+    }
+    s.tick(t, hal);
+    if (crossings_at_10 < 0 && x > 10.0) crossings_at_10 = s.telemetry().finish_crossings;
+    if (x > 45.0) break;
+  }
+  EXPECT_EQ(crossings_at_10, 1);  // the start, once its gate was seen behind the car
+  EXPECT_EQ(s.telemetry().finish_crossings, 2);
+  EXPECT_TRUE(s.telemetry().stopping);
+  EXPECT_EQ(s.gates().size(), 2u);
+}
+
 }  // namespace
 }  // namespace paddock::stack
