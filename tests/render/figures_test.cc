@@ -18,39 +18,14 @@
 #include <unistd.h>
 
 #include "render/figures.h"
+#include "tests/render/figure_test_util.h"
 
 namespace paddock::render {
 namespace {
 
-const char* kFont = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-
-std::vector<std::uint8_t> read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-const std::vector<std::uint8_t>& font() {
-  static const std::vector<std::uint8_t> bytes = read_bytes(kFont);
-  return bytes;
-}
-
-FigureStyle style(int w, int h) {
-  FigureStyle s;
-  s.width = w;
-  s.height = h;
-  s.font = &font();
-  return s;
-}
-
-// the figure as a PNG file's bytes and back (what a user opens)
-Image round_trip(const Figure& fig, const std::string& name) {
-  const std::vector<std::uint8_t> png = encode_png(fig.image);
-  if (const char* dir = std::getenv("PADDOCK_RENDER_OUT")) {
-    std::ofstream(std::string(dir) + "/" + name + ".png", std::ios::binary)
-        .write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-  }
-  return decode_png(png);
-}
+using testing::font;
+using testing::round_trip;
+using testing::style;
 
 // ---- a real track: FSG 2023 ----
 

@@ -16,37 +16,14 @@
 #include <vector>
 
 #include "render/figures.h"
+#include "tests/render/figure_test_util.h"
 
 namespace paddock::render {
 namespace {
 
-// ---- helpers (as in figures_test.cc) ----
-
-const std::vector<std::uint8_t>& font() {
-  static const std::vector<std::uint8_t> bytes = [] {
-    std::ifstream in("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf", std::ios::binary);
-    return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }();
-  return bytes;
-}
-
-FigureStyle style(int w, int h) {
-  FigureStyle s;
-  s.width = w;
-  s.height = h;
-  s.font = &font();
-  return s;
-}
-
-// the figure as a PNG file's bytes and back (what a user opens)
-Image round_trip(const Figure& fig, const std::string& name) {
-  const std::vector<std::uint8_t> png = encode_png(fig.image);
-  if (const char* dir = std::getenv("PADDOCK_RENDER_OUT")) {
-    std::ofstream(std::string(dir) + "/" + name + ".png", std::ios::binary)
-        .write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-  }
-  return decode_png(png);
-}
+using testing::font;
+using testing::round_trip;
+using testing::style;
 
 bool same(Rgba a, Rgba b, int tol) {
   return std::abs(a.r - b.r) <= tol && std::abs(a.g - b.g) <= tol && std::abs(a.b - b.b) <= tol &&
