@@ -19,11 +19,13 @@ std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t 
 
 RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
                        const std::optional<sensors::CameraParams>& camera, std::uint64_t seed)
-    : lidar_(lidar, seed), ground_(ground), poses_(2 * lidar_.period_ns()) {
+    : lidar_(lidar, seed), ground_(ground) {
   if (camera) camera_ = std::make_unique<sensors::Camera>(*camera, seed ^ 0xC0FFEEULL);
 }
 
-void RawSensors::record(TimeNs now, const Pose2& base) { poses_.record(now, base); }
+TimeNs RawSensors::scan_end(TimeNs now) const {
+  return lidar_.column_time(now - lidar_.period_ns(), lidar_.params().columns - 1);
+}
 
 bool RawSensors::rotation_ends(TimeNs now) const {
   const TimeNs period = lidar_.period_ns();
@@ -68,17 +70,18 @@ void RawSensors::update_scene(const world::ConeWorld& cones) {
   world_ = std::make_unique<sensors::LidarWorld>(scene_cones_, scene_knocked_, ground_);
 }
 
-const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeWorld& cones, SimHal& hal) {
+const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,
+                                                  SimHal& hal) {
   update_scene(cones);
   const TimeNs start = now - lidar_.period_ns();
   if (camera_) {
     const TimeNs exposure = sensors::trigger_time(lidar_.params(), camera_->params().trigger_azimuth, start);
-    hal.post(camera_->render(*world_, poses_.at(exposure), exposure));
+    hal.post(camera_->render(*world_, poses.at(exposure), exposure));
   }
-  const std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [this](TimeNs t) { return poses_.at(t); }, start);
+  const std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [&poses](TimeNs t) { return poses.at(t); }, start);
   hal::LidarScan scan;
   scan.stamp = start;
-  scan.end = lidar_.column_time(start, lidar_.params().columns - 1);
+  scan.end = scan_end(now);
   scan.points.resize(raw.size());
   truth_.resize(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) {

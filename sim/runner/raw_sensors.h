@@ -3,8 +3,8 @@
 // closed loop: the rotating LiDAR (and the camera it triggers) ray-cast the
 // cone world as it stands, from the car's pose at each column's own time.
 //
-// The loop records the base pose every physics step; when a rotation is over,
-// the whole scan is cast from the recorded poses of that rotation (each column
+// The loop records the base pose every physics step (PoseHistory); when a
+// rotation is over, the whole scan is cast from the recorded poses of that rotation (each column
 // from the pose at its own time, interpolated between physics steps), and
 // posted to the HAL as it would arrive from the driver: at the end of the
 // rotation. The Embree scene is rebuilt only when a cone moved or fell.
@@ -45,17 +45,18 @@ class RawSensors {
   RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
              const std::optional<sensors::CameraParams>& camera, std::uint64_t seed);
 
-  // the base pose at `now` (call every physics step, times increasing)
-  void record(TimeNs now, const Pose2& base);
   // true when a rotation ends at `now` (one starts at 0, then every period)
   bool rotation_ends(TimeNs now) const;
-  // casts the rotation that ends at `now` against the cones as they stand and
+  // casts the rotation that ends at `now` against the cones as they stand,
+  // each column from its pose in `poses` (which must cover the rotation), and
   // posts the camera frame it triggered (exposed at the trigger column's time,
-  // from the pose of that instant), then the scan; returns its ground truth: per point the cone index hit
-  // (-1 the ground), in the order of the scan's points
-  const std::vector<std::int32_t>& emit(TimeNs now, const world::ConeWorld& cones, SimHal& hal);
+  // from the pose of that instant), then the scan; returns its ground truth:
+  // per point the cone index hit (-1 the ground), in the order of the scan's points
+  const std::vector<std::int32_t>& emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,
+                                        SimHal& hal);
+  // the stamp of the scan's last column (the scan's `end`) for a rotation ending at `now`
+  TimeNs scan_end(TimeNs now) const;
 
-  TimeNs period_ns() const { return lidar_.period_ns(); }
 
  private:
   void update_scene(const world::ConeWorld& cones);
@@ -66,7 +67,6 @@ class RawSensors {
   std::unique_ptr<sensors::LidarWorld> world_;
   std::vector<Cone> scene_cones_;
   std::vector<bool> scene_knocked_;
-  PoseHistory poses_;  // the last rotation and a bit
   std::vector<std::int32_t> truth_;
 };
 

@@ -1,5 +1,6 @@
 #include "sim/runner/simulation.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -192,7 +193,9 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
 
   // perception metrics: each frame the stack got, against the truth of its instant
   PerceptionMetrics metrics;
-  PoseHistory truth_poses(kNsPerSecond);
+  // the true base poses of the last second (two LiDAR rotations at least):
+  // the LiDAR's columns and the metrics' frames look up the pose of their instant
+  PoseHistory truth_poses(std::max(kNsPerSecond, 2 * from_seconds(1.0 / sc.lidar.rate)));
   // (frame stamp, cones the sensor could see): the LiDAR hit them, or the
   // cone sensor had them in view unoccluded
   std::deque<std::pair<TimeNs, std::vector<bool>>> scan_visible;
@@ -229,14 +232,10 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
 
     // a LiDAR rotation that ends now, cast from the poses it was taken at
     truth_poses.record(now, base);
-    if (raw) {
-      raw->record(now, base);
-      if (raw->rotation_ends(now)) {
-        const std::vector<std::int32_t>& hit_truth = raw->emit(now, cones, hal);
-        const TimeNs end = now - raw->period_ns() / sc.lidar.columns;  // the last column's time
-        scan_visible.emplace_back(end, cones_hit(hit_truth, truth_cones.size()));
-        while (scan_visible.size() > 4) scan_visible.pop_front();
-      }
+    if (raw && raw->rotation_ends(now)) {
+      const std::vector<std::int32_t>& hit_truth = raw->emit(now, cones, truth_poses, hal);
+      scan_visible.emplace_back(raw->scan_end(now), cones_hit(hit_truth, truth_cones.size()));
+      while (scan_visible.size() > 4) scan_visible.pop_front();
     }
 
     // odometry: the IMU at the base origin's acceleration (from the CG's: a_base = a_cg
