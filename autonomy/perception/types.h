@@ -20,9 +20,10 @@ struct LidarCalibration {
   // about its y axis, > 0 tilts it nose down)
   double mount_x = 2.2, mount_y = 0.0, mount_z = 0.15;  // m
   double mount_pitch = 0.0;                             // rad
-  // channels evenly spaced in elevation from elevation_min to elevation_max;
-  // the defaults are the simulated sensor's (sensors::LidarParams): 32
-  // channels over -8 .. +7.5 deg (0.5 deg)
+  // channels evenly spaced in elevation from elevation_min to elevation_max:
+  // 32 channels over -8 .. +7.5 deg (0.5 deg). These defaults are also the
+  // simulated sensor's (sensors::LidarParams takes them; why this layout:
+  // sim/sensors/lidar.h)
   int channels = 32;
   double elevation_min = -8.0 * kPi / 180.0;  // rad
   double elevation_max = 7.5 * kPi / 180.0;   // rad

@@ -52,8 +52,13 @@
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
 #include "autonomy/common/time.h"
+#include "autonomy/perception/types.h"
 
 namespace paddock::sensors {
+
+// the layout and mounting below default to perception::LidarCalibration's:
+// the numbers are written once, where the stack's calibration is
+inline const perception::LidarCalibration kDefaultLidarLayout{};
 
 struct LidarParams {
   // channels, evenly spaced in elevation from elevation_min to elevation_max
@@ -71,11 +76,11 @@ struct LidarParams {
   // outside) spread evenly over a narrow field, like a narrow-FoV 32-beam
   // unit (an Ouster OS2-32: 22.5 deg, 0.7 deg uniform), not the 40 deg
   // fans that waste half their beams on the sky and the car's own nose.
-  int channels = 32;                               // -, in [1, 65535]
-  double elevation_min = -8.0 * kPi / 180.0;       // rad
-  double elevation_max = 7.5 * kPi / 180.0;        // rad
+  int channels = kDefaultLidarLayout.channels;                // -, in [1, 65535]: 32
+  double elevation_min = kDefaultLidarLayout.elevation_min;  // rad: -8 deg
+  double elevation_max = kDefaultLidarLayout.elevation_max;  // rad: +7.5 deg
   // columns per rotation: 1024 gives a 6.1 mrad horizontal resolution
-  int columns = 1024;  // -
+  int columns = kDefaultLidarLayout.columns;  // -
   // rotation rate; DESIGN.md's LiDAR rate
   double rate = 10.0;  // Hz
   // range limits: 0.5 m blind zone of common FS LiDARs; 50 m far beyond where
@@ -88,10 +93,10 @@ struct LidarParams {
   double dropout = 0.0;  // -, in [0, 1)
   // mounting in the base frame: on the nose cone, low, as in the paper
   // (about 0.7 m ahead of the front axle of a 1.53 m wheelbase)
-  double mount_x = 2.2;       // m
-  double mount_y = 0.0;       // m
-  double mount_z = 0.15;      // m, above the ground
-  double mount_pitch = 0.0;   // rad, > 0 nose down
+  double mount_x = kDefaultLidarLayout.mount_x;          // m: 2.2
+  double mount_y = kDefaultLidarLayout.mount_y;          // m: 0
+  double mount_z = kDefaultLidarLayout.mount_z;          // m, above the ground: 0.15
+  double mount_pitch = kDefaultLidarLayout.mount_pitch;  // rad, > 0 nose down: 0
   // intensity material model: reflectivities (diffuse, 905 nm, all in [0, 1])
   double reflect_white = 0.9;    // white stripe (retro-ish white foil / paint)
   double reflect_yellow = 0.6;   // yellow cone body
