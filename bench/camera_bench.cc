@@ -17,13 +17,12 @@
 
 #include <algorithm>
 #include <chrono>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "autonomy/perception/detector.h"
 #include "autonomy/perception/fusion.h"
+#include "bench/bench_scenes.h"
 #include "sim/sensors/camera.h"
 #include "sim/world/track.h"
 
@@ -31,13 +30,7 @@ namespace {
 
 using namespace paddock;
 
-world::TrackModel fsg_2023() {
-  const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/tracks/fsg_2023.csv";
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return world::build_track(world::parse_track(text.str(), path));
-}
+world::TrackModel fsg_2023() { return bench::real_track("fsg_2023"); }
 
 // n base poses along the centreline, each looking at the point 2 m ahead
 std::vector<Pose2> poses_along(const world::TrackModel& t, int n) {

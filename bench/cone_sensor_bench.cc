@@ -13,43 +13,22 @@
 #include <cmath>
 #include <vector>
 
+#include "bench/bench_scenes.h"
 #include "sim/sensors/cone_sensor.h"
 
 namespace {
 
 using namespace paddock;
 
-Vec2 centreline(double t) {
-  const double ripple = 4.0 * std::sin(6.0 * t);
-  return {(60.0 + ripple) * std::cos(t), (35.0 + ripple) * std::sin(t)};
-}
-
-// the unit tangent of the centreline at t (central difference)
-Vec2 tangent(double t) {
-  const Vec2 d = centreline(t + 1e-5) - centreline(t - 1e-5);
-  return d / norm(d);
-}
-
-std::vector<Cone> track_cones(int per_side) {
-  std::vector<Cone> cones;
-  for (int i = 0; i < per_side; ++i) {
-    const double t = 2.0 * kPi * i / per_side;
-    const Vec2 n = left_normal(tangent(t));
-    cones.push_back({centreline(t) + 1.5 * n, ConeColor::Blue});
-    cones.push_back({centreline(t) - 1.5 * n, ConeColor::Yellow});
-  }
-  return cones;
-}
-
 void BM_ConeSensorMeasure(benchmark::State& state) {
-  const std::vector<Cone> cones = track_cones(static_cast<int>(state.range(0)) / 2);
+  const std::vector<Cone> cones = bench::oval_cones(static_cast<int>(state.range(0)) / 2);
   const std::vector<bool> knocked(cones.size(), false);
   constexpr int kPlaces = 32;
   std::vector<Pose2> poses;
   for (int k = 0; k < kPlaces; ++k) {
     const double t = 2.0 * kPi * (k + 0.5) / kPlaces;
-    const Vec2 c = centreline(t);
-    poses.push_back({c.x, c.y, angle_of(tangent(t))});
+    const Vec2 c = bench::oval_centreline(t);
+    poses.push_back({c.x, c.y, angle_of(bench::oval_tangent(t))});
   }
   sensors::ConeSensor sensor(sensors::ConeSensorParams{}, 2024);
   std::size_t k = 0;

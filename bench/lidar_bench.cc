@@ -13,39 +13,19 @@
 #include <cmath>
 #include <vector>
 
+#include "bench/bench_scenes.h"
 #include "sim/sensors/lidar.h"
 
 namespace {
 
 using namespace paddock;
 
-Vec2 lidar_centreline(double t) {
-  const double ripple = 4.0 * std::sin(6.0 * t);
-  return {(60.0 + ripple) * std::cos(t), (35.0 + ripple) * std::sin(t)};
-}
-
-Vec2 lidar_tangent(double t) {
-  const Vec2 d = lidar_centreline(t + 1e-5) - lidar_centreline(t - 1e-5);
-  return d / norm(d);
-}
-
-std::vector<Cone> lidar_track_cones(int per_side) {
-  std::vector<Cone> cones;
-  for (int i = 0; i < per_side; ++i) {
-    const double t = 2.0 * kPi * i / per_side;
-    const Vec2 n = left_normal(lidar_tangent(t));
-    cones.push_back({lidar_centreline(t) + 1.5 * n, ConeColor::Blue});
-    cones.push_back({lidar_centreline(t) - 1.5 * n, ConeColor::Yellow});
-  }
-  return cones;
-}
-
 void BM_LidarScan(benchmark::State& state) {
-  const std::vector<Cone> cones = lidar_track_cones(static_cast<int>(state.range(0)) / 2);
+  const std::vector<Cone> cones = bench::oval_cones(static_cast<int>(state.range(0)) / 2);
   sensors::LidarWorld world(cones);
   sensors::Lidar lidar(sensors::LidarParams{}, 1);
-  const Vec2 p0 = lidar_centreline(0.0);
-  const double yaw = angle_of(lidar_tangent(0.0));
+  const Vec2 p0 = bench::oval_centreline(0.0);
+  const double yaw = angle_of(bench::oval_tangent(0.0));
   auto pose_at = [p0, yaw](TimeNs t) {
     const double s = to_seconds(t);
     const Vec2 p = p0 + 10.0 * s * unit_from_angle(yaw);
@@ -64,7 +44,7 @@ void BM_LidarScan(benchmark::State& state) {
 BENCHMARK(BM_LidarScan)->Arg(200)->Unit(benchmark::kMillisecond);
 
 void BM_LidarWorldBuild(benchmark::State& state) {
-  const std::vector<Cone> cones = lidar_track_cones(static_cast<int>(state.range(0)) / 2);
+  const std::vector<Cone> cones = bench::oval_cones(static_cast<int>(state.range(0)) / 2);
   for (auto _ : state) {
     sensors::LidarWorld world(cones);
     benchmark::DoNotOptimize(world.scene());

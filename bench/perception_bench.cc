@@ -15,12 +15,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "autonomy/perception/lidar_pipeline.h"
+#include "bench/bench_scenes.h"
 #include "sim/sensors/lidar.h"
 #include "sim/world/track.h"
 
@@ -29,11 +28,7 @@ namespace {
 using namespace paddock;
 
 void BM_LidarPipeline(benchmark::State& state) {
-  const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/tracks/fsg_2023.csv";
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  const world::TrackModel track = world::build_track(world::parse_track(text.str(), path));
+  const world::TrackModel track = bench::real_track("fsg_2023");
   const std::size_t i = track.centreline.size() / 4;
   const Vec2 p0 = track.centreline[i];
   const double yaw0 = angle_of(track.centreline[i + 1] - p0);
