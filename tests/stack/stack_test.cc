@@ -4,8 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
+#include <optional>
 #include <vector>
 
 namespace paddock::stack {
@@ -152,6 +154,46 @@ TEST(Stack, CountsFinishCrossingsThenStopsAndFinishes) {
   EXPECT_EQ(s.telemetry().fallbacks, 0);
 }
 
+// blue cones at y = 1.75 and yellow at y = -1.75, every 3 m from x = -6 to x_last
+std::vector<Cone> corridor(double x_last) {
+  std::vector<Cone> track;
+  for (double x = -6.0; x <= x_last; x += 3.0) {
+    track.push_back({{x, 1.75}, ConeColor::Blue});
+    track.push_back({{x, -1.75}, ConeColor::Yellow});
+  }
+  return track;
+}
+
+// drives the stack's car along +x, ignoring its commands: at rest at x0 for
+// 1 s (the go at 0.5 s), then 5 m/s, 100 ticks a second, until past x_stop or
+// after `seconds`. Every 0.1 s a perception frame holds each cone i for which
+// see(i, rel, x) gives a colour (rel: the cone in the base frame, x: the
+// car's); after(x) runs after every tick.
+template <class See, class After>
+void drive_corridor(Stack& s, const std::vector<Cone>& track, double x0, double x_stop, int seconds, See see,
+                    After after) {
+  ScriptedHal hal;
+  const double v = 5.0;
+  for (int k = 0; k < 100 * seconds; ++k) {
+    const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
+    const double x = k < 100 ? x0 : x0 + v * (k - 100) * 0.01;
+    hal.inbox.push_back(state_at(t, {x, 0.0}, 0.0, k < 100 ? 0.0 : v));
+    if (k == 50) hal.inbox.push_back(hal::ResSignal{t, true, false});
+    if (k % 10 == 0) {
+      hal::ConeDetections d;
+      d.stamp = t;
+      for (std::size_t i = 0; i < track.size(); ++i) {
+        const Vec2 rel = track[i].position - Vec2{x, 0.0};
+        if (const std::optional<ConeColor> c = see(i, rel, x)) d.cones.push_back({rel, *c});
+      }
+      hal.inbox.push_back(d);
+    }
+    s.tick(t, hal);
+    after(x);
+    if (x > x_stop) break;
+  }
+}
+
 // a straight corridor (blue left, yellow right) with a real timekeeping gate of
 // big orange cones at x = 10 and, at x = 30, a pair the perception first calls
 // big orange (from afar) and then, nearer, blue and yellow: the stack learns
@@ -165,41 +207,22 @@ TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
   m.mission = Mission::Autocross;
   m.finish_crossings = 2;
   Stack s(p, m);
-  ScriptedHal hal;
-  std::vector<Cone> track;
-  for (double x = -6.0; x <= 70.0; x += 3.0) {
-    track.push_back({{x, 1.75}, ConeColor::Blue});
-    track.push_back({{x, -1.75}, ConeColor::Yellow});
-  }
+  std::vector<Cone> track = corridor(70.0);
   track.push_back({{10.0, 2.6}, ConeColor::BigOrange});
   track.push_back({{10.0, -2.6}, ConeColor::BigOrange});
   const std::size_t fake_left = track.size();
   track.push_back({{30.0, 2.6}, ConeColor::BigOrange});
   track.push_back({{30.0, -2.6}, ConeColor::BigOrange});
-  const double v = 5.0;
   int learned_max = 0;
-  for (int k = 0; k < 100 * 10; ++k) {
-    const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
-    const double x = k < 100 ? 0.0 : v * (k - 100) * 0.01;  // at rest for 1 s, then 5 m/s along +x
-    hal.inbox.push_back(state_at(t, {x, 0.0}, 0.0, k < 100 ? 0.0 : v));
-    if (k == 50) hal.inbox.push_back(hal::ResSignal{t, true, false});
-    if (k % 10 == 0) {
-      // a perception frame of the cones within 20 m ahead
-      hal::ConeDetections d;
-      d.stamp = t;
-      for (std::size_t i = 0; i < track.size(); ++i) {
-        const Vec2 rel = track[i].position - Vec2{x, 0.0};
-        if (rel.x < -2.0 || rel.x > 20.0) continue;
-        ConeColor c = track[i].color;
-        if (i >= fake_left && x > 16.0) c = i == fake_left ? ConeColor::Blue : ConeColor::Yellow;
-        d.cones.push_back({rel, c});
-      }
-      hal.inbox.push_back(d);
-    }
-    s.tick(t, hal);
-    learned_max = std::max(learned_max, static_cast<int>(s.gates().size()));
-    if (x > 45.0) break;
-  }
+  drive_corridor(
+      s, track, 0.0, 45.0, 10,
+      [&](std::size_t i, Vec2 rel, double x) -> std::optional<ConeColor> {
+        // the cones within 20 m ahead; the fake pair small once the car is near
+        if (rel.x < -2.0 || rel.x > 20.0) return std::nullopt;
+        if (i >= fake_left && x > 16.0) return i == fake_left ? ConeColor::Blue : ConeColor::Yellow;
+        return track[i].color;
+      },
+      [&](double) { learned_max = std::max(learned_max, static_cast<int>(s.gates().size())); });
   EXPECT_EQ(learned_max, 2);                   // both pairs were taken for gates at first
   EXPECT_EQ(s.telemetry().finish_crossings, 1);  // only the real one counted
   EXPECT_FALSE(s.telemetry().stopping);
@@ -220,40 +243,24 @@ TEST(Stack, AGateSeenOnlyAfterTheCarCrossedItCounts) {
   m.mission = Mission::Acceleration;
   m.finish_crossings = 2;
   Stack s(p, m);
-  ScriptedHal hal;
-  std::vector<Cone> track;
-  for (double x = -6.0; x <= 90.0; x += 3.0) {
-    track.push_back({{x, 1.75}, ConeColor::Blue});
-    track.push_back({{x, -1.75}, ConeColor::Yellow});
-  }
+  std::vector<Cone> track = corridor(90.0);
   const std::size_t start_left = track.size();
   track.push_back({{0.0, 2.6}, ConeColor::BigOrange});
   track.push_back({{0.0, -2.6}, ConeColor::BigOrange});
   track.push_back({{30.0, 2.6}, ConeColor::BigOrange});
   track.push_back({{30.0, -2.6}, ConeColor::BigOrange});
-  const double v = 5.0;
   int crossings_at_10 = -1;
-  for (int k = 0; k < 100 * 12; ++k) {
-    const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
-    const double x = k < 100 ? -2.0 : -2.0 + v * (k - 100) * 0.01;  // at rest for 1 s, then 5 m/s along +x
-    hal.inbox.push_back(state_at(t, {x, 0.0}, 0.0, k < 100 ? 0.0 : v));
-    if (k == 50) hal.inbox.push_back(hal::ResSignal{t, true, false});
-    if (k % 10 == 0) {
-      hal::ConeDetections d;
-      d.stamp = t;
-      for (std::size_t i = 0; i < track.size(); ++i) {
-        const Vec2 rel = track[i].position - Vec2{x, 0.0};
+  drive_corridor(
+      s, track, -2.0, 45.0, 12,
+      [&](std::size_t i, Vec2 rel, double) -> std::optional<ConeColor> {
         // the start gate only from behind, everything else 3-20 m ahead
         const bool seen = i == start_left || i == start_left + 1 ? rel.x < -1.0 && rel.x > -8.0
                                                                  : rel.x > 3.0 && rel.x < 20.0;
-        if (seen) d.cones.push_back({rel, track[i].color});
-      }
-      hal.inbox.push_back(d);
-    }
-    s.tick(t, hal);
-    if (crossings_at_10 < 0 && x > 10.0) crossings_at_10 = s.telemetry().finish_crossings;
-    if (x > 45.0) break;
-  }
+        return seen ? std::optional<ConeColor>(track[i].color) : std::nullopt;
+      },
+      [&](double x) {
+        if (crossings_at_10 < 0 && x > 10.0) crossings_at_10 = s.telemetry().finish_crossings;
+      });
   EXPECT_EQ(crossings_at_10, 1);  // the start, once its gate was seen behind the car
   EXPECT_EQ(s.telemetry().finish_crossings, 2);
   EXPECT_TRUE(s.telemetry().stopping);
