@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "autonomy/common/time.h"
+#include "tests/sensors/sample_stats.h"
 
 namespace paddock::sensors {
 namespace {
@@ -33,18 +34,8 @@ ImuParams perfect() {
   return p;
 }
 
-struct Stats {
-  double mean;
-  double stddev;
-};
-Stats stats(const std::vector<double>& v) {
-  double sum = 0.0;
-  for (double x : v) sum += x;
-  const double mean = sum / static_cast<double>(v.size());
-  double ss = 0.0;
-  for (double x : v) ss += (x - mean) * (x - mean);
-  return {mean, std::sqrt(ss / static_cast<double>(v.size() - 1))};
-}
+using testing::Stats;
+using testing::stats;
 
 TEST(ImuParams, DefaultsAreValid) { EXPECT_EQ(validate(ImuParams{}), ""); }
 

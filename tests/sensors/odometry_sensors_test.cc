@@ -3,6 +3,7 @@
 // correction res^2 / 12 once quantised), brute-force nearest multiples, and
 // the physics of an encoder at rest.
 #include "sim/sensors/odometry_sensors.h"
+#include "tests/sensors/sample_stats.h"
 
 #include <gtest/gtest.h>
 
@@ -17,18 +18,8 @@
 namespace paddock::sensors {
 namespace {
 
-struct Stats {
-  double mean;
-  double stddev;
-};
-Stats stats(const std::vector<double>& v) {
-  double sum = 0.0;
-  for (double x : v) sum += x;
-  const double mean = sum / static_cast<double>(v.size());
-  double ss = 0.0;
-  for (double x : v) ss += (x - mean) * (x - mean);
-  return {mean, std::sqrt(ss / static_cast<double>(v.size() - 1))};
-}
+using testing::Stats;
+using testing::stats;
 
 // v is step * k for an integer k, exactly as the sensor writes it
 bool exact_multiple(double v, double step) { return v == step * std::round(v / step); }
