@@ -3,6 +3,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -100,6 +102,25 @@ std::string without_wall_clock(std::string json) {
   return std::regex_replace(json, std::regex("\"realtime_factor\":[^,]*,"), "");
 }
 
+// FNV-1a, 64 bit: the log's fingerprint (not a cryptographic hash; it need
+// only change when a byte changes)
+std::uint64_t fnv1a64(const std::string& bytes) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (const unsigned char c : bytes) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+// the pinned fingerprint: tests/data/determinism.txt, line "log_fnv1a64 = 0x..."
+std::string pinned_log_hash() {
+  const std::string text = paddock::runner::read_file(kRoot + "/tests/data/determinism.txt");
+  std::smatch m;
+  if (!std::regex_search(text, m, std::regex("log_fnv1a64 = (0x[0-9a-f]{16})"))) return "";
+  return m[1];
+}
+
 TEST(Cli, SameScenarioAndSeedGiveIdenticalSummaryAndLog) {
   // the default scenario (raw LiDAR and camera, perception, planning,
   // control), its first 40 s after the go: the lap of exploration and more
@@ -112,6 +133,12 @@ TEST(Cli, SameScenarioAndSeedGiveIdenticalSummaryAndLog) {
   const std::string log_b = paddock::runner::read_file(scratch("det_b") + "/log.csv");
   EXPECT_GT(log_a.size(), 100000u);
   EXPECT_TRUE(log_a == log_b) << "log.csv differs between two runs";
+  // and the same as the build that pinned it: a change of any result shows here
+  char hash[19];
+  std::snprintf(hash, sizeof hash, "0x%016llx", static_cast<unsigned long long>(fnv1a64(log_a)));
+  EXPECT_EQ(std::string(hash), pinned_log_hash())
+      << "the default run's log changed; if on purpose, set log_fnv1a64 = " << hash
+      << " in tests/data/determinism.txt and say why in the commit";
   const std::string sum_a = paddock::runner::read_file(scratch("det_a") + "/summary.json");
   const std::string sum_b = paddock::runner::read_file(scratch("det_b") + "/summary.json");
   EXPECT_EQ(without_wall_clock(sum_a), without_wall_clock(sum_b));
