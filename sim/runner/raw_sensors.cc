@@ -18,9 +18,10 @@ std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t 
 }
 
 RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
-                       const std::optional<sensors::CameraParams>& camera, std::uint64_t seed)
-    : lidar_(lidar, seed), ground_(ground) {
-  if (camera) camera_ = std::make_unique<sensors::Camera>(*camera, seed ^ 0xC0FFEEULL);
+                       const std::optional<sensors::CameraParams>& camera, std::uint64_t lidar_seed,
+                       std::uint64_t camera_seed)
+    : lidar_(lidar, lidar_seed), ground_(ground) {
+  if (camera) camera_ = std::make_unique<sensors::Camera>(*camera, camera_seed);
 }
 
 TimeNs RawSensors::scan_end(TimeNs now) const {

@@ -42,8 +42,9 @@ std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t 
 class RawSensors {
  public:
   // camera: the camera the LiDAR triggers (perception = lidar_camera), or none
+  // the LiDAR and the camera each draw from their own random stream
   RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
-             const std::optional<sensors::CameraParams>& camera, std::uint64_t seed);
+             const std::optional<sensors::CameraParams>& camera, std::uint64_t lidar_seed, std::uint64_t camera_seed);
 
   // true when a rotation ends at `now` (one starts at 0, then every period)
   bool rotation_ends(TimeNs now) const;

@@ -1,5 +1,6 @@
 #include "sim/runner/scenario.h"
 
+#include <cassert>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -625,6 +626,22 @@ world::TrackFile load_track_file(const std::string& path) {
   return world::parse_track(read_file(path), path);
 }
 
+std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream) {
+  // one offset per stream on a Weyl step of the golden ratio; the camera's
+  // stream is the LiDAR's, scrambled
+  struct Stream {
+    std::string_view name;
+    std::uint64_t offset, scramble;
+  };
+  static constexpr Stream kStreams[] = {{"cone_sensor", 1, 0},     {"imu", 2, 0},   {"wheel_speeds", 3, 0},
+                                        {"steering_sensor", 4, 0}, {"lidar", 5, 0}, {"camera", 5, 0xC0FFEEULL},
+                                        {"stack", 6, 0}};
+  for (const Stream& s : kStreams)
+    if (s.name == stream) return (scenario_seed * 0x9E3779B97F4A7C15ULL + s.offset) ^ s.scramble;
+  assert(false && "unknown random stream");
+  return scenario_seed;
+}
+
 stack::StackParams stack_params(const Scenario& s) {
   stack::StackParams p;
   p.modes = s.autonomy;
@@ -647,7 +664,7 @@ stack::StackParams stack_params(const Scenario& s) {
   k.rolling_resistance = v.cr0;
   // perception: the sensors' calibration is their true mounting and layout,
   // the odometry's wheel radius the car's
-  p.seed = s.scenario.seed * 0x9E3779B97F4A7C15ULL + 6;
+  p.seed = stream_seed(s.scenario.seed, "stack");
   p.perception = s.perception;
   p.perception.odometry.wheel_radius = v.wheel_radius;
   perception::LidarCalibration& lc = p.perception.lidar.calibration;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "autonomy/stack/stack.h"
@@ -93,6 +94,13 @@ std::string resolved_ini(const Scenario& s);
 // reads and parses a track file; throws UserError "path: cannot open ..." or
 // world::TrackError "path:line: ..."
 world::TrackFile load_track_file(const std::string& path);
+
+// the seed of one named random stream of a run: every random draw of a run
+// comes from the scenario's seed through this function. The streams:
+// "cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera",
+// "stack"; any other name is a programming error. Their numbering is fixed:
+// changing it changes every result.
+std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream);
 
 // the stack's parameters as compiled from the scenario (the vehicle knowledge
 // comes from the same [vehicle] section as the simulated car)

@@ -1,52 +1,89 @@
 #pragma once
-// the closed loop: vehicle, cone world and event at the physics rate; the
-// stack behind the sim HAL at the control rate; log rows at the log rate.
+// the closed loop as model, state and step (MuJoCo's mj_step(m, d)):
+//   SimModel  constant, compiled once from the scenario (model.h)
+//   SimState  everything that changes: the car, the cones, the event, the
+//             stack, the sensors and their random streams, the messages in
+//             flight, the true poses of the last second
+//   step()    one physics step, then what falls due at the new instant: the
+//             sensors into the sim HAL, the stack's control cycle, the event's
+//             sample
+// Observers (observers.h) watch from outside the loop. run() is "step until
+// the event is done". States share nothing: two simulations of one model run
+// side by side on two threads exactly as each runs alone.
 #include <cstdint>
+#include <deque>
+#include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
+#include "sim/runner/model.h"
+#include "sim/runner/observers.h"
 #include "sim/runner/perception_metrics.h"
+#include "sim/runner/raw_sensors.h"
 #include "sim/runner/scenario.h"
+#include "sim/runner/sim_hal.h"
+#include "sim/sensors/cone_sensor.h"
+#include "sim/sensors/imu.h"
+#include "sim/sensors/odometry_sensors.h"
+#include "sim/vehicle/vehicle.h"
+#include "sim/world/cone_world.h"
 #include "sim/world/track.h"
 
 namespace paddock::runner {
 
-// one row of log.csv (100 Hz by default)
-struct LogRow {
-  double t = 0.0;          // sim time (s)
-  double x = 0.0;          // base frame (rear axle centre) in the map (m)
-  double y = 0.0;
-  double yaw = 0.0;        // rad
-  double vx = 0.0;         // base-frame velocity (m/s)
-  double vy = 0.0;
-  double yaw_rate = 0.0;   // rad/s
-  double steer_cmd = 0.0;  // commanded road-wheel angle (rad)
-  double steer = 0.0;      // actual road-wheel angle (rad)
-  double throttle = 0.0;   // commanded [0, 1]
-  double brake = 0.0;      // commanded [0, 1]
-  double v_ref = 0.0;      // reference speed (m/s)
-  double lateral_error = 0.0;  // front axle offset from the reference path, > 0 left (m)
-  double heading_error = 0.0;  // path heading - vehicle yaw (rad)
-  double s = 0.0;          // arc length of the projection on the reference (m)
-  int lap = 0;             // lap being driven, 0 before the first crossing
-  int as_state = 0;        // hal::AsState as an integer
+struct SimState {
+  // the world at t = 0 (car at the start pose, at rest, brakes on; cones in
+  // place; every sensor's random stream seeded), with what falls due at t = 0
+  // already run. The model must outlive the state.
+  explicit SimState(const SimModel& model);
+  SimState(const SimState&) = delete;
+  SimState& operator=(const SimState&) = delete;
+
+  long k = 0;  // physics steps taken
+  TimeNs now = 0;
+  double t = 0.0;  // s, k dt
+  bool done = false;  // the event is over (finish or DNF): step no more
+
+  vehicle::VehicleState car;
+  world::ConeWorld cones;
+  events::Event event;
+  stack::Stack stack;
+  SimHal hal;
+  vehicle::DriverInput input{0.0, 0.0, 1.0};  // the stack's last command, as the actuators take it
+  hal::AsState as_state = hal::AsState::Off;
+  bool go_sent = false;
+  int control_cycles = 0;
+  // what the current instant ran
+  bool controlled = false;  // a control cycle
+  bool sampled = false;     // the event's sample (and a log row)
+
+  // perception = ground_truth: the object-level sensor; its frames reach the
+  // HAL after their latency (delivery time, frame)
+  sensors::ConeSensor cone_sensor;
+  std::deque<std::pair<TimeNs, hal::ConeDetections>> in_flight;
+  std::vector<Cone> cones_now;        // scratch: the cones as they stand
+  std::vector<bool> cones_knocked;
+  // perception = lidar | lidar_camera: the LiDAR and the camera it triggers
+  std::unique_ptr<RawSensors> raw;
+  sensors::Imu imu;
+  sensors::WheelSpeedSensor wheel_speeds;
+  sensors::SteeringSensor steering;
+
+  // the truth behind the sensors, for the observers: the true base poses of
+  // the last second, and per sensor frame (stamp) the cones it could see (the
+  // LiDAR hit them, or the cone sensor had them in view unoccluded)
+  PoseHistory true_poses;
+  std::deque<std::pair<TimeNs, std::vector<bool>>> visible;
 };
 
-// tracking errors over the timed laps (definitions in the README)
-struct Tracking {
-  double rms = 0.0;   // m
-  double max = 0.0;   // m
-  double itae = 0.0;  // m s^2, mean over the completed laps of integral (t - t_lap) |e| dt
-};
-
-struct LapTracking {
-  double rms = 0.0;
-  double max = 0.0;
-  double itae = 0.0;
-};
+// advances the state one physics step (the car, the cones it may hit, the
+// timing gates), then runs what falls due at the new instant. Must not be
+// called once state.done.
+void step(const SimModel& model, SimState& state);
 
 // a cone that went down or out
 struct ConeHit {
@@ -66,31 +103,6 @@ struct PlanSnapshot {
   std::vector<Vec2> reference;         // the trajectory it drove last
 };
 
-// one perception frame of the run, kept for the perception figures (perception
-// = lidar | lidar_camera): the first scan the stack processed after
-// [sim] snapshot_time. Everything in the base frame at the scan's end.
-struct PerceptionSnapshot {
-  double t = 0.0;  // s, the scan's reference time
-  struct Point {
-    float x, y, z;
-    std::uint8_t label;  // 0 ground, 1 non-ground, 2 cone
-  };
-  std::vector<Point> points;
-  std::vector<Cone> detected;  // what perception delivered
-  std::vector<Cone> truth;     // the true cones within 40 m
-  // the camera frame fused with that scan (lidar_camera), if any
-  bool camera = false;
-  int width = 0, height = 0;
-  std::vector<std::uint8_t> rgb;
-  struct Box {
-    double x_min, y_min, x_max, y_max;
-    ConeColor color;
-  };
-  std::vector<Box> boxes;
-  std::vector<Vec2> projected;  // cluster centres the camera coloured or left to the LiDAR, px
-  std::vector<Vec2> dropped;    // cluster centres fusion dropped, px
-};
-
 struct RunResult {
   events::Result event;
   PlanSnapshot plan;
@@ -106,20 +118,6 @@ struct RunResult {
   PerceptionMetrics perception;  // the stack's perceived cones against the truth, per range bin
   std::optional<PerceptionSnapshot> snapshot;
 };
-
-// the mission the car is given for an event on a track (planner = oracle: also
-// the ground-truth path of the event and its timekeeping gates)
-stack::MissionSpec mission_for(events::EventKind kind, const world::TrackModel& track, stack::PlannerMode planner);
-
-// the cones standing at the event: the track's, plus a big orange cone at
-// each timekeeping post when the file has no big orange cones at all (the
-// rules mark timekeeping lines with them; some files only give the posts)
-std::vector<Cone> event_cones(const world::TrackModel& track);
-
-// where the car starts: the track's start pose, moved back along its heading
-// when that would put the car's nose less than 0.3 m behind the first gate
-// (the rules' start position; some files give the pose of the car's centre)
-Pose2 start_pose(const world::TrackModel& track, double nose_offset);
 
 // runs one scenario to its end (finish or DNF); deterministic for a given
 // scenario and build, apart from wall_time

@@ -1,0 +1,127 @@
+#include "sim/runner/observers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "sim/runner/model.h"
+#include "sim/runner/simulation.h"
+
+namespace paddock::runner {
+namespace {
+
+PerceptionSnapshot take_snapshot(const perception::Perception& p, const Pose2& pose, const world::ConeWorld& cones) {
+  const perception::PerceptionFrame& f = p.last();
+  PerceptionSnapshot s;
+  s.t = to_seconds(f.output.stamp);
+  for (const perception::LabelledPoint& q : f.lidar.points) {
+    const std::uint8_t label = q.label == perception::PointLabel::Ground ? 0 : q.label == perception::PointLabel::Cone ? 2 : 1;
+    s.points.push_back({q.x, q.y, q.z, label});
+  }
+  for (const hal::DetectedCone& c : f.output.cones) s.detected.push_back({c.position, c.color});
+  for (int i = 0; i < cones.cone_count(); ++i) {
+    const Vec2 local = pose.inverse_transform(cones.cone_position(i));
+    if (norm(local) <= 40.0) s.truth.push_back({local, cones.cone(i).color});
+  }
+  if (f.camera_used && p.camera_frame()) {
+    const hal::CameraFrame& frame = *p.camera_frame();
+    s.camera = true;
+    s.width = frame.width;
+    s.height = frame.height;
+    s.rgb = frame.rgb;
+    for (const perception::BoundingBox& b : f.detection.boxes) s.boxes.push_back({b.x_min, b.y_min, b.x_max, b.y_max, b.color});
+    for (const perception::FusedCone& c : f.fusion.cones) {
+      if (!c.projected) continue;
+      (c.source == perception::FusionSource::Dropped ? s.dropped : s.projected).push_back({c.pixel.x(), c.pixel.y()});
+    }
+  }
+  return s;
+}
+
+}  // namespace
+
+void LogRecorder::observe(const SimModel& model, SimState& s) {
+  if (!s.sampled) return;
+  const Pose2 base = vehicle::base_pose(model.scenario.vehicle, s.car);
+  const Vec2 v = vehicle::base_velocity(model.scenario.vehicle, s.car);
+  const control::Diagnostics& c = s.stack.telemetry().control;
+  LogRow row;
+  row.t = s.t;
+  row.x = base.x;
+  row.y = base.y;
+  row.yaw = base.yaw;
+  row.vx = v.x;
+  row.vy = v.y;
+  row.yaw_rate = s.car.r;
+  row.steer_cmd = s.input.steering_angle;
+  row.steer = s.car.steering;
+  row.throttle = s.input.throttle;
+  row.brake = s.input.brake;
+  row.v_ref = c.v_ref;
+  row.lateral_error = c.lateral_error;
+  row.heading_error = c.heading_error;
+  row.s = c.s;
+  row.lap = s.event.current_lap();
+  row.as_state = static_cast<int>(s.as_state);
+  rows_.push_back(row);
+}
+
+void PerceptionScorer::observe(const SimModel& model, SimState& s) {
+  if (s.stack.detection_frames() <= scored_frames_) return;
+  scored_frames_ = s.stack.detection_frames();
+  const hal::ConeDetections& d = s.stack.last_detections();
+  truth_.resize(static_cast<std::size_t>(s.cones.cone_count()));
+  for (std::size_t i = 0; i < truth_.size(); ++i)
+    truth_[i] = {s.cones.cone_position(static_cast<int>(i)), s.cones.cone(static_cast<int>(i)).color};
+  // the cones the sensor could see in the frame of that stamp
+  const std::vector<bool>* visible = nullptr;
+  for (const auto& [stamp, hit] : s.visible)
+    if (std::llabs(stamp - d.stamp) < model.dt_ns) visible = &hit;
+  if (visible && !visible->empty()) metrics_.add(d, s.true_poses.at(d.stamp), model.perception_mount, truth_, *visible);
+}
+
+void SnapshotRecorder::observe(const SimModel& model, SimState& s) {
+  perception::Perception* p = s.stack.perception();
+  if (!p || snapshot_) return;
+  const long frames = s.stack.detection_frames();
+  const bool new_frame = frames > frames_seen_;
+  frames_seen_ = frames;
+  const double snapshot_time = model.scenario.sim.snapshot_time;
+  if (armed_ && new_frame && s.t >= snapshot_time) {
+    snapshot_ = take_snapshot(*p, s.true_poses.at(s.stack.last_detections().stamp), s.cones);
+    p->set_keep_points(false);
+  } else if (!armed_ && static_cast<double>(s.k + 1) * model.dt >= snapshot_time) {
+    // perception keeps the points from the next step on
+    p->set_keep_points(true);
+    armed_ = true;
+  }
+}
+
+void tracking_from_log(const std::vector<events::Lap>& laps, const std::vector<LogRow>& log, double log_dt,
+                       std::vector<LapTracking>& per_lap, Tracking& all) {
+  per_lap.assign(laps.size(), LapTracking{});
+  all = Tracking{};
+  std::vector<double> sum2(laps.size(), 0.0);
+  std::vector<int> count(laps.size(), 0);
+  for (const LogRow& row : log) {
+    if (row.lap < 1 || row.lap > static_cast<int>(laps.size())) continue;
+    const auto i = static_cast<std::size_t>(row.lap - 1);
+    const double e = std::abs(row.lateral_error);
+    sum2[i] += e * e;
+    ++count[i];
+    per_lap[i].max = std::max(per_lap[i].max, e);
+    per_lap[i].itae += (row.t - laps[i].start) * e * log_dt;
+  }
+  double all2 = 0.0;
+  int all_n = 0;
+  for (std::size_t i = 0; i < laps.size(); ++i) {
+    per_lap[i].rms = count[i] > 0 ? std::sqrt(sum2[i] / count[i]) : 0.0;
+    all2 += sum2[i];
+    all_n += count[i];
+    all.max = std::max(all.max, per_lap[i].max);
+    all.itae += per_lap[i].itae / static_cast<double>(laps.size());
+  }
+  all.rms = all_n > 0 ? std::sqrt(all2 / all_n) : 0.0;
+}
+
+}  // namespace paddock::runner

@@ -1,0 +1,155 @@
+// the closed loop as model, state and step: a simulation stepped from outside
+// is the one run() runs, and simulations of one model share nothing (two on
+// two threads give what each gives alone)
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <thread>
+
+#include "sim/runner/model.h"
+#include "sim/runner/simulation.h"
+
+namespace paddock::runner {
+namespace {
+
+const std::string kRoot = PADDOCK_SOURCE_DIR;
+
+// the default scenario (raw LiDAR and camera: the Embree scenes, the
+// perception, the stack's random streams) for the first few seconds of driving
+struct ScenarioOnTrack {
+  Scenario scenario;
+  world::TrackModel track;
+};
+const ScenarioOnTrack& default_setup() {
+  static const ScenarioOnTrack s = [] {
+    ScenarioOnTrack out;
+    out.scenario = load_scenario(kRoot + "/scenarios/fsg_2023_trackdrive.ini", {"event.timeout=6"});
+    out.track = world::build_track(load_track_file(out.scenario.track_path));
+    return out;
+  }();
+  return s;
+}
+
+// steps a state of the model to the end, recording its log and perception metrics
+struct Trace {
+  std::vector<LogRow> log;
+  long scans = 0;
+  long steps = 0;
+  events::Result event;
+};
+Trace drive(const SimModel& model) {
+  SimState state(model);
+  LogRecorder log;
+  PerceptionScorer scorer;
+  Trace out;
+  for (;;) {
+    log.observe(model, state);
+    scorer.observe(model, state);
+    if (state.done) break;
+    step(model, state);
+    ++out.steps;
+  }
+  out.log = log.rows();
+  out.scans = scorer.metrics().frames();
+  out.event = state.event.result();
+  return out;
+}
+
+// bit for bit: every field of every row
+bool same_rows(const std::vector<LogRow>& a, const std::vector<LogRow>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const LogRow& x = a[i];
+    const LogRow& y = b[i];
+    const double xs[] = {x.t, x.x, x.y, x.yaw, x.vx, x.vy, x.yaw_rate, x.steer_cmd, x.steer, x.throttle, x.brake,
+                         x.v_ref, x.lateral_error, x.heading_error, x.s};
+    const double ys[] = {y.t, y.x, y.y, y.yaw, y.vx, y.vy, y.yaw_rate, y.steer_cmd, y.steer, y.throttle, y.brake,
+                         y.v_ref, y.lateral_error, y.heading_error, y.s};
+    if (std::memcmp(xs, ys, sizeof xs) != 0 || x.lap != y.lap || x.as_state != y.as_state) return false;
+  }
+  return true;
+}
+
+TEST(Simulation, SteppedFromOutsideItIsTheRunOfRun) {
+  const ScenarioOnTrack& s = default_setup();
+  const SimModel model = compile_model(s.scenario, s.track);
+  const Trace stepped = drive(model);
+  const RunResult ran = run(s.scenario, s.track);
+  EXPECT_TRUE(same_rows(stepped.log, ran.log));
+  EXPECT_EQ(stepped.scans, ran.perception.frames());
+  EXPECT_EQ(stepped.event.dnf_reason, ran.event.dnf_reason);
+  // the car drove and perception ran: the comparison is not of two empty runs
+  ASSERT_FALSE(stepped.log.empty());
+  EXPECT_GT(std::hypot(stepped.log.back().x - stepped.log.front().x, stepped.log.back().y - stepped.log.front().y), 20.0);
+  EXPECT_GT(stepped.scans, 50);
+}
+
+TEST(Simulation, StepAdvancesTimeByOnePhysicsStep) {
+  const ScenarioOnTrack& s = default_setup();
+  const SimModel model = compile_model(s.scenario, s.track);
+  SimState state(model);
+  EXPECT_EQ(state.k, 0);
+  EXPECT_EQ(state.now, 0);
+  // at t = 0 the control cycle and the sample have already run
+  EXPECT_TRUE(state.controlled);
+  EXPECT_TRUE(state.sampled);
+  EXPECT_EQ(state.control_cycles, 1);
+  for (int i = 0; i < 25; ++i) step(model, state);
+  EXPECT_EQ(state.k, 25);
+  EXPECT_EQ(state.now, 25 * model.dt_ns);
+  EXPECT_DOUBLE_EQ(state.t, 0.025);
+  // 100 Hz control at 1 kHz physics: steps 0, 10, 20
+  EXPECT_EQ(state.control_cycles, 3);
+  EXPECT_FALSE(state.controlled);
+}
+
+TEST(Simulation, TwoSimulationsOfOneModelOnTwoThreadsGiveWhatEachGivesAlone) {
+  const ScenarioOnTrack& s = default_setup();
+  const SimModel model = compile_model(s.scenario, s.track);
+  const Trace alone = drive(model);
+  Trace a, b;
+  std::thread ta([&] { a = drive(model); });
+  std::thread tb([&] { b = drive(model); });
+  ta.join();
+  tb.join();
+  EXPECT_TRUE(same_rows(alone.log, a.log));
+  EXPECT_TRUE(same_rows(alone.log, b.log));
+  EXPECT_EQ(alone.scans, a.scans);
+  EXPECT_EQ(alone.scans, b.scans);
+  EXPECT_EQ(alone.steps, a.steps);
+}
+
+TEST(Simulation, TwoModelsWithOtherSeedsOnTwoThreadsStayApart) {
+  // a different seed changes the run; each still matches its own run alone
+  const ScenarioOnTrack& s = default_setup();
+  Scenario other = s.scenario;
+  other.scenario.seed = 7;
+  const SimModel m1 = compile_model(s.scenario, s.track);
+  const SimModel m2 = compile_model(other, s.track);
+  const Trace alone1 = drive(m1);
+  const Trace alone2 = drive(m2);
+  EXPECT_FALSE(same_rows(alone1.log, alone2.log));
+  Trace a, b;
+  std::thread ta([&] { a = drive(m1); });
+  std::thread tb([&] { b = drive(m2); });
+  ta.join();
+  tb.join();
+  EXPECT_TRUE(same_rows(alone1.log, a.log));
+  EXPECT_TRUE(same_rows(alone2.log, b.log));
+}
+
+TEST(Simulation, StreamSeedsDifferPerStream) {
+  const char* streams[] = {"cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera", "stack"};
+  for (const char* a : streams) {
+    for (const char* b : streams) {
+      if (std::strcmp(a, b) != 0) {
+        EXPECT_NE(stream_seed(1, a), stream_seed(1, b)) << a << " " << b;
+      }
+    }
+  }
+  EXPECT_NE(stream_seed(1, "imu"), stream_seed(2, "imu"));
+}
+
+}  // namespace
+}  // namespace paddock::runner
