@@ -13,7 +13,6 @@ namespace paddock::perception {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
 
 // nanoflann's view of the points being clustered (x, y)
 struct XyAdaptor {
@@ -41,26 +40,10 @@ struct Clusterer::Index {
   std::vector<std::pair<std::uint32_t, float>> matches;
 };
 
-std::string validate(const ClusteringParams& p) {
-  std::ostringstream os;
-  if (!finite(p.tolerance) || !(p.tolerance > 0.0)) {
-    os << "tolerance must be finite and > 0 m (got " << p.tolerance << ")";
-  } else if (!finite(p.max_range) || !(p.max_range > 0.0)) {
-    os << "max_range must be finite and > 0 m (got " << p.max_range << ")";
-  } else if (p.min_points < 1) {
-    os << "min_points must be >= 1 (got " << p.min_points << ")";
-  } else if (p.max_points < p.min_points) {
-    os << "max_points must be >= min_points (got " << p.max_points << ")";
-  }
-  return os.str();
-}
-
 Clusterer::Clusterer(const ClusteringParams& params, const LidarCalibration& calibration)
     : params_(params), calib_(calibration), index_(std::make_unique<Index>()) {
-  std::string err = validate(params_);
-  if (!err.empty()) throw std::invalid_argument("ClusteringParams: " + err);
-  err = validate(calib_);
-  if (!err.empty()) throw std::invalid_argument("LidarCalibration: " + err);
+  params::require_valid(params_, "ClusteringParams");
+  params::require_valid(calib_, "LidarCalibration");
 }
 
 Clusterer::~Clusterer() = default;

@@ -28,27 +28,31 @@
 #include <utility>
 #include <vector>
 
+#include "autonomy/common/params.h"
+
 #include "autonomy/perception/motion_correction.h"
 
 namespace paddock::perception {
 
 struct ClusteringParams {
-  double tolerance = 0.4;  // m, > 0 (see the top)
-  // only points this close to the sensor (horizontally) are clustered: a
-  // small cone gets a single return beyond ~20 m
-  double max_range = 25.0;  // m, > 0
-  // clusters with fewer points are dropped here (the cone filter applies
-  // the real, range-dependent count test)
-  int min_points = 1;  // -, >= 1
-  // clusters with more points are no cones (with the default 0.5 deg
-  // sensor a small cone at 1 m gets ~800, a big one ~1150, and nearer than
-  // that a cone stands under the nose): dropped before the costlier stages
-  int max_points = 2000;  // -, >= min_points
-};
+  double tolerance = 0.4;
+  // a small cone gets a single return beyond ~20 m
+  double max_range = 25.0;
+  // the cone filter applies the real, range-dependent count test
+  int min_points = 1;
+  // with the default 0.5 deg sensor a small cone at 1 m gets ~800 points, a
+  // big one ~1150, and nearer than that a cone stands under the nose
+  int max_points = 2000;
 
-// "" when every field is usable, else the first problem, starting with the
-// field name
-std::string validate(const ClusteringParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(tolerance), {"m", params::above(0.0), "points closer than this (in the ground plane) join one cluster"});
+    v(PADDOCK_PARAM(max_range), {"m", params::above(0.0), "only points this close to the sensor (horizontally) are clustered"});
+    v(PADDOCK_PARAM(min_points), {"", params::at_least(1), "clusters with fewer points are dropped"});
+    v(PADDOCK_PARAM(max_points), {"", params::at_least(1), "clusters with more points are no cones (dropped before the costlier stages)"});
+  }
+  std::string check() const { return max_points < min_points ? "max_points must be >= min_points" : ""; }
+};
 
 // clusters as index lists into Cloud::points: cluster k is
 // members[offsets[k] .. offsets[k + 1])

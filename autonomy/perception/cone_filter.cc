@@ -67,8 +67,7 @@ ConeFilter::ConeFilter(const ConeFilterParams& params, const LidarCalibration& c
     : params_(params), calib_(calibration) {
   std::string err = validate(params_);
   if (!err.empty()) throw std::invalid_argument("ConeFilterParams: " + err);
-  err = validate(calib_);
-  if (!err.empty()) throw std::invalid_argument("LidarCalibration: " + err);
+  params::require_valid(calib_, "LidarCalibration");
   // one channel: no vertical spacing; take a narrow 1 deg beam
   res_v_ = calib_.channels > 1 ? (calib_.elevation_max - calib_.elevation_min) / (calib_.channels - 1)
                                : kPi / 180.0;

@@ -61,8 +61,7 @@ GroundSegmenter::GroundSegmenter(const GroundSegmentationParams& params,
     : params_(params), calib_(calibration), rings_(params.region_bounds.size() + 1) {
   std::string err = validate(params_);
   if (!err.empty()) throw std::invalid_argument("GroundSegmentationParams: " + err);
-  err = validate(calib_);
-  if (!err.empty()) throw std::invalid_argument("LidarCalibration: " + err);
+  params::require_valid(calib_, "LidarCalibration");
 }
 
 void GroundSegmenter::inter_ring(Cloud& cloud, GroundStats& stats) const {

@@ -9,9 +9,9 @@ std::string validate(const LidarPipelineParams& p) {
   const auto prefixed = [](const char* stage, const std::string& err) {
     return err.empty() ? err : std::string(stage) + "." + err;
   };
-  std::string err = prefixed("calibration", validate(p.calibration));
+  std::string err = prefixed("calibration", params::validate(p.calibration));
   if (err.empty()) err = prefixed("ground", validate(p.ground));
-  if (err.empty()) err = prefixed("clustering", validate(p.clustering));
+  if (err.empty()) err = prefixed("clustering", params::validate(p.clustering));
   if (err.empty()) err = prefixed("cone", validate(p.cone));
   if (err.empty()) err = prefixed("colour", validate(p.colour));
   if (err.empty() && p.colour.big_cone_height != p.cone.big_cone_height) {

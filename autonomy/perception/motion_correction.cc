@@ -9,7 +9,6 @@ namespace paddock::perception {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
 
 bool usable(const hal::LidarPoint& p, int channels) {
   return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) &&
@@ -18,31 +17,8 @@ bool usable(const hal::LidarPoint& p, int channels) {
 
 }  // namespace
 
-std::string validate(const LidarCalibration& c) {
-  std::ostringstream os;
-  const double half_pi = 0.5 * kPi;
-  if (!finite(c.mount_x) || !finite(c.mount_y)) {
-    os << "mount_x and mount_y must be finite m";
-  } else if (!finite(c.mount_z) || !(c.mount_z > 0.0)) {
-    os << "mount_z must be finite and > 0 m (got " << c.mount_z << ")";
-  } else if (!finite(c.mount_pitch) || !(std::abs(c.mount_pitch) < half_pi)) {
-    os << "mount_pitch must be in (-pi/2, pi/2) rad (got " << c.mount_pitch << ")";
-  } else if (c.channels < 1 || c.channels > 65535) {
-    os << "channels must be in [1, 65535] (got " << c.channels << ")";
-  } else if (!finite(c.elevation_min) || !(c.elevation_min > -half_pi)) {
-    os << "elevation_min must be finite and > -pi/2 rad (got " << c.elevation_min << ")";
-  } else if (!finite(c.elevation_max) || !(c.elevation_max < half_pi) ||
-             !(c.elevation_max > c.elevation_min)) {
-    os << "elevation_max must be in (elevation_min, pi/2) rad (got " << c.elevation_max << ")";
-  } else if (c.columns < 1) {
-    os << "columns must be >= 1 (got " << c.columns << ")";
-  }
-  return os.str();
-}
-
 MotionCorrector::MotionCorrector(const LidarCalibration& calibration) : calib_(calibration) {
-  const std::string err = validate(calib_);
-  if (!err.empty()) throw std::invalid_argument("LidarCalibration: " + err);
+  params::require_valid(calib_, "LidarCalibration");
   cos_pitch_ = std::cos(calib_.mount_pitch);
   sin_pitch_ = std::sin(calib_.mount_pitch);
 }

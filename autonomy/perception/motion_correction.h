@@ -35,10 +35,6 @@
 
 namespace paddock::perception {
 
-// "" when the calibration is usable, else the first problem, starting with
-// the field name
-std::string validate(const LidarCalibration& c);
-
 // what the pipeline made of a point
 enum class PointLabel : std::uint8_t { Ground, NonGround, Cone };
 

@@ -11,24 +11,13 @@
 
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
+#include "autonomy/hal/lidar_layout.h"
 
 namespace paddock::perception {
 
-// where the LiDAR sits and how its beams are laid out
-struct LidarCalibration {
-  // mounting in the base frame (the sensor frame's yaw is the base's; pitch
-  // about its y axis, > 0 tilts it nose down)
-  double mount_x = 2.2, mount_y = 0.0, mount_z = 0.15;  // m
-  double mount_pitch = 0.0;                             // rad
-  // channels evenly spaced in elevation from elevation_min to elevation_max:
-  // 32 channels over -8 .. +7.5 deg (0.5 deg). These defaults are also the
-  // simulated sensor's (sensors::LidarParams takes them; why this layout:
-  // sim/sensors/lidar.h)
-  int channels = 32;
-  double elevation_min = -8.0 * kPi / 180.0;  // rad
-  double elevation_max = 7.5 * kPi / 180.0;   // rad
-  int columns = 1024;                          // per rotation
-};
+// where the LiDAR sits and how its beams are laid out: the sensor's own
+// layout and mounting (one struct with the simulated sensor's, hal/lidar_layout.h)
+using LidarCalibration = hal::LidarLayout;
 
 // the pinhole camera: intrinsics K and extrinsics [R|T] = T_camera_base (the
 // base frame into the camera's optical frame: z forward, x right, y down)

@@ -586,7 +586,7 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   if (const std::string why = sensors::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
   if (const std::string why = sensors::validate(s.wheel_speeds); !why.empty()) throw UserError(path + ": [wheel_speeds] " + why);
   if (const std::string why = sensors::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
-  if (const std::string why = sensors::validate(s.lidar); !why.empty()) throw UserError(path + ": [lidar] " + why);
+  if (const std::string why = params::validate(s.lidar); !why.empty()) throw UserError(path + ": [lidar] " + why);
   if (const std::string why = sensors::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
   if (const std::string why = sensors::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
   if (const std::string why = perception::validate(stack_params(s).perception); !why.empty()) {
@@ -667,15 +667,7 @@ stack::StackParams stack_params(const Scenario& s) {
   p.seed = stream_seed(s.scenario.seed, "stack");
   p.perception = s.perception;
   p.perception.odometry.wheel_radius = v.wheel_radius;
-  perception::LidarCalibration& lc = p.perception.lidar.calibration;
-  lc.mount_x = s.lidar.mount_x;
-  lc.mount_y = s.lidar.mount_y;
-  lc.mount_z = s.lidar.mount_z;
-  lc.mount_pitch = s.lidar.mount_pitch;
-  lc.channels = s.lidar.channels;
-  lc.elevation_min = s.lidar.elevation_min;
-  lc.elevation_max = s.lidar.elevation_max;
-  lc.columns = s.lidar.columns;
+  p.perception.lidar.calibration = static_cast<const hal::LidarLayout&>(s.lidar);
   p.perception.camera = sensors::camera_calibration(s.camera);
   p.planner = s.planning;
   p.planner.reference.profile.mass = v.mass;

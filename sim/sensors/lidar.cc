@@ -36,7 +36,6 @@ void check(RTCDevice device, const char* what) {
 constexpr int kConeVertices = 2 * kConeSegments + 1;  // base ring, top ring, top centre
 constexpr int kConeTriangles = 3 * kConeSegments;     // lateral quads (2 each), top fan
 
-bool unit_interval(double v) { return finite(v) && v >= 0.0 && v <= 1.0; }
 
 }  // namespace
 
@@ -69,49 +68,6 @@ double reflectivity(const LidarParams& p, LidarMaterial m) {
     case LidarMaterial::Ground: return p.reflect_ground;
   }
   return 0.0;
-}
-
-std::string validate(const LidarParams& p) {
-  std::ostringstream os;
-  const double half_pi = 0.5 * kPi;
-  if (p.channels < 1 || p.channels > 65535) {
-    os << "channels must be in [1, 65535] (got " << p.channels << ")";
-  } else if (!finite(p.elevation_min) || !(p.elevation_min > -half_pi)) {
-    os << "elevation_min must be finite and > -pi/2 (got " << p.elevation_min << ")";
-  } else if (!finite(p.elevation_max) || !(p.elevation_max < half_pi)) {
-    os << "elevation_max must be finite and < pi/2 (got " << p.elevation_max << ")";
-  } else if (p.channels > 1 ? !(p.elevation_max > p.elevation_min)
-                            : !(p.elevation_max >= p.elevation_min)) {
-    os << "elevation_max must be > elevation_min (got " << p.elevation_max
-       << " <= " << p.elevation_min << ")";
-  } else if (p.columns < 1) {
-    os << "columns must be >= 1 (got " << p.columns << ")";
-  } else if (!finite(p.rate) || !(p.rate > 0.0)) {
-    os << "rate must be finite and > 0 (got " << p.rate << ")";
-  } else if (!finite(p.range_min) || !(p.range_min >= 0.0)) {
-    os << "range_min must be finite and >= 0 (got " << p.range_min << ")";
-  } else if (!finite(p.range_max) || !(p.range_max > p.range_min)) {
-    os << "range_max must be finite and > range_min (got " << p.range_max
-       << " <= " << p.range_min << ")";
-  } else if (!finite(p.range_noise) || !(p.range_noise >= 0.0)) {
-    os << "range_noise must be finite and >= 0 (got " << p.range_noise << ")";
-  } else if (!finite(p.dropout) || !(p.dropout >= 0.0 && p.dropout < 1.0)) {
-    os << "dropout must be in [0, 1) (got " << p.dropout << ")";
-  } else if (!finite(p.mount_x) || !finite(p.mount_y) || !finite(p.mount_z)) {
-    os << "mount_x, mount_y and mount_z must be finite";
-  } else if (!finite(p.mount_pitch) || !(std::abs(p.mount_pitch) < half_pi)) {
-    os << "mount_pitch must be in (-pi/2, pi/2) (got " << p.mount_pitch << ")";
-  } else if (!unit_interval(p.reflect_white) || !unit_interval(p.reflect_yellow) ||
-             !unit_interval(p.reflect_orange) || !unit_interval(p.reflect_blue) ||
-             !unit_interval(p.reflect_black) || !unit_interval(p.reflect_grey) ||
-             !unit_interval(p.reflect_ground)) {
-    os << "reflect_* must all be in [0, 1]";
-  } else if (!finite(p.intensity_range_ref) || !(p.intensity_range_ref > 0.0)) {
-    os << "intensity_range_ref must be finite and > 0 (got " << p.intensity_range_ref << ")";
-  } else if (!finite(p.intensity_noise) || !(p.intensity_noise >= 0.0)) {
-    os << "intensity_noise must be finite and >= 0 (got " << p.intensity_noise << ")";
-  }
-  return os.str();
 }
 
 std::string validate(const GroundParams& g) {
@@ -357,8 +313,7 @@ LidarMaterial LidarWorld::material_of(unsigned geom_id, unsigned prim_id, double
 // --------------------------------------------------------------------- Lidar
 
 Lidar::Lidar(const LidarParams& params, std::uint64_t seed) : params_(params), rng_(seed) {
-  const std::string err = validate(params_);
-  if (!err.empty()) throw std::invalid_argument("LidarParams: " + err);
+  params::require_valid(params_, "LidarParams");
   const auto nch = static_cast<std::size_t>(params_.channels);
   const auto ncol = static_cast<std::size_t>(params_.columns);
   cos_el_.resize(nch);

@@ -52,52 +52,24 @@
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
 #include "autonomy/common/time.h"
-#include "autonomy/perception/types.h"
+#include "autonomy/hal/lidar_layout.h"
 
 namespace paddock::sensors {
 
-// the layout and mounting below default to perception::LidarCalibration's:
-// the numbers are written once, where the stack's calibration is
-inline const perception::LidarCalibration kDefaultLidarLayout{};
-
-struct LidarParams {
-  // channels, evenly spaced in elevation from elevation_min to elevation_max
-  // (both included). 32 channels over -8 .. +7.5 deg: a 0.5 deg vertical
-  // resolution, with a channel level with the optical centre (channel 16,
-  // 0 deg). The beams go where the cones are: seen from 0.15 m above the
-  // ground a small cone (0.325 m) 1 m ahead spans -8.5 .. +9.9 deg, one 5 m
-  // ahead -1.7 .. +2.0 deg, 10 m ahead -0.9 .. +1.0 deg; a 1 deg fan over
-  // -16 .. +15 deg puts only two rings on it beyond ~8 m, too few for the
-  // intensity profile's parabola (autonomy/perception/intensity_colour.h),
-  // this one three out to ~11 m (four out to ~7 m). The lowest ring meets
-  // the ground 1.07 m ahead; a cone closer than ~1.3 m loses its top. What
-  // the layout resembles: the 0.33 - 0.5 deg band around the horizon of a
-  // Velodyne VLP-32C or Hesai Pandar40P (-6 .. +2 deg at 0.33 deg, coarser
-  // outside) spread evenly over a narrow field, like a narrow-FoV 32-beam
-  // unit (an Ouster OS2-32: 22.5 deg, 0.7 deg uniform), not the 40 deg
-  // fans that waste half their beams on the sky and the car's own nose.
-  int channels = kDefaultLidarLayout.channels;                // -, in [1, 65535]: 32
-  double elevation_min = kDefaultLidarLayout.elevation_min;  // rad: -8 deg
-  double elevation_max = kDefaultLidarLayout.elevation_max;  // rad: +7.5 deg
-  // columns per rotation: 1024 gives a 6.1 mrad horizontal resolution
-  int columns = kDefaultLidarLayout.columns;  // -
-  // rotation rate; DESIGN.md's LiDAR rate
-  double rate = 10.0;  // Hz
-  // range limits: 0.5 m blind zone of common FS LiDARs; 50 m far beyond where
-  // a cone still gets more than a point or two
-  double range_min = 0.5;   // m
-  double range_max = 50.0;  // m
-  // Gaussian range noise std along the ray; the paper quotes 2-3 cm
-  double range_noise = 0.02;  // m
-  // probability that a ray returns nothing
-  double dropout = 0.0;  // -, in [0, 1)
-  // mounting in the base frame: on the nose cone, low, as in the paper
-  // (about 0.7 m ahead of the front axle of a 1.53 m wheelbase)
-  double mount_x = kDefaultLidarLayout.mount_x;          // m: 2.2
-  double mount_y = kDefaultLidarLayout.mount_y;          // m: 0
-  double mount_z = kDefaultLidarLayout.mount_z;          // m, above the ground: 0.15
-  double mount_pitch = kDefaultLidarLayout.mount_pitch;  // rad, > 0 nose down: 0
-  // intensity material model: reflectivities (diffuse, 905 nm, all in [0, 1])
+// the rotating LiDAR: its layout and mounting (hal::LidarLayout, the same
+// struct the stack is told as its calibration), rate, range, noise and the
+// intensity model of the cones' materials
+struct LidarParams : hal::LidarLayout {
+  // DESIGN.md's LiDAR rate
+  double rate = 10.0;
+  // a 0.5 m blind zone as common FS LiDARs have; 50 m is far beyond where a
+  // cone still gets more than a point or two
+  double range_min = 0.5;
+  double range_max = 50.0;
+  // the paper quotes 2-3 cm
+  double range_noise = 0.02;
+  double dropout = 0.0;
+  // the materials' reflectivities (diffuse, 905 nm)
   double reflect_white = 0.9;    // white stripe (retro-ish white foil / paint)
   double reflect_yellow = 0.6;   // yellow cone body
   double reflect_orange = 0.5;   // orange cone body
@@ -105,15 +77,32 @@ struct LidarParams {
   double reflect_black = 0.05;   // black stripe
   double reflect_grey = 0.4;     // cones of unknown colour: plain grey
   double reflect_ground = 0.15;  // asphalt
-  // range fall-off min(1, (intensity_range_ref / r)^2)
-  double intensity_range_ref = 5.0;  // m, > 0
-  // Gaussian intensity noise std (before clamping to [0, 1])
-  double intensity_noise = 0.01;  // -
-};
+  double intensity_range_ref = 5.0;
+  double intensity_noise = 0.01;
 
-// "" when every field is usable, else the first problem, starting with the
-// field name
-std::string validate(const LidarParams& p);
+  template <class V>
+  void visit(V& v) {
+    hal::LidarLayout::visit(v);
+    v(PADDOCK_PARAM(rate), {"Hz", params::in(0.1, 1000.0), "rotations per second"});
+    v(PADDOCK_PARAM(range_min), {"m", params::in(0.0, 1000.0), "nearest return (the blind zone)"});
+    v(PADDOCK_PARAM(range_max), {"m", params::in(0.1, 1000.0), "farthest return"});
+    v(PADDOCK_PARAM(range_noise), {"m", params::in(0.0, 10.0), "range noise std along the ray"});
+    v(PADDOCK_PARAM(dropout), {"", params::in(0.0, 0.99), "chance that a ray returns nothing"});
+    v(PADDOCK_PARAM(reflect_white), {"", params::fraction(), "reflectivity of the white stripes"});
+    v(PADDOCK_PARAM(reflect_yellow), {"", params::fraction(), "reflectivity of a yellow cone's body"});
+    v(PADDOCK_PARAM(reflect_orange), {"", params::fraction(), "reflectivity of an orange cone's body"});
+    v(PADDOCK_PARAM(reflect_blue), {"", params::fraction(), "reflectivity of a blue cone's body"});
+    v(PADDOCK_PARAM(reflect_black), {"", params::fraction(), "reflectivity of the black stripes"});
+    v(PADDOCK_PARAM(reflect_grey), {"", params::fraction(), "reflectivity of a cone of unknown colour"});
+    v(PADDOCK_PARAM(reflect_ground), {"", params::fraction(), "reflectivity of the ground"});
+    v(PADDOCK_PARAM(intensity_range_ref), {"m", params::above(0.0), "the intensity falls off as min(1, (ref / r)^2)"});
+    v(PADDOCK_PARAM(intensity_noise), {"", params::fraction(), "intensity noise std (before clamping to [0, 1])"});
+  }
+  std::string check() const {
+    if (const std::string why = hal::LidarLayout::check(); !why.empty()) return why;
+    return range_max > range_min ? "" : "range_max must be > range_min";
+  }
+};
 
 // an Embree failure (device creation, buffer allocation, scene commit)
 class LidarError : public std::runtime_error {

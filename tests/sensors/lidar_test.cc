@@ -502,30 +502,30 @@ TEST(LidarKnocked, KnockedConeLiesOnItsSide) {
 
 TEST(LidarTest, InvalidParamsAreRejected) {
   LidarParams p;
-  EXPECT_EQ(validate(p), "");
+  EXPECT_EQ(params::validate(p), "");
   p.channels = 0;
   EXPECT_THROW(Lidar(p, 1), std::invalid_argument);
   p = LidarParams{};
   p.range_max = p.range_min;
-  EXPECT_NE(validate(p).find("range_max"), std::string::npos);
+  EXPECT_NE(params::validate(p).find("range_max"), std::string::npos);
   p = LidarParams{};
   p.dropout = 1.0;
-  EXPECT_NE(validate(p).find("dropout"), std::string::npos);
+  EXPECT_NE(params::validate(p).find("dropout"), std::string::npos);
   p = LidarParams{};
   p.elevation_max = p.elevation_min;
-  EXPECT_NE(validate(p).find("elevation_max"), std::string::npos);
+  EXPECT_NE(params::validate(p).find("elevation_max"), std::string::npos);
   p = LidarParams{};
   p.rate = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_NE(validate(p).find("rate"), std::string::npos);
+  EXPECT_NE(params::validate(p).find("rate"), std::string::npos);
   p = LidarParams{};
   p.reflect_blue = 1.5;
-  EXPECT_NE(validate(p).find("reflect_"), std::string::npos);
+  EXPECT_NE(params::validate(p).find("reflect_"), std::string::npos);
   p = LidarParams{};
   p.intensity_noise = -0.1;
-  EXPECT_NE(validate(p).find("intensity_noise"), std::string::npos);
+  EXPECT_NE(params::validate(p).find("intensity_noise"), std::string::npos);
   p = LidarParams{};
   p.intensity_range_ref = 0.0;
-  EXPECT_NE(validate(p).find("intensity_range_ref"), std::string::npos);
+  EXPECT_NE(params::validate(p).find("intensity_range_ref"), std::string::npos);
 }
 
 
