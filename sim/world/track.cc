@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "autonomy/common/line_fit.h"
 #include "autonomy/common/polyline.h"
 
 namespace paddock::world {
@@ -658,65 +659,58 @@ void build_circuit(TrackModel& m, const TrackFile& f, const ConeSets& cs) {
 // ---------------------------------------------------------------------------
 // acceleration: two straight parallel lines of blue and yellow cones
 
-struct LineFit {
-  Vec2 centroid;
-  Vec2 direction;
-  double max_residual = 0.0;
-  double extent = 0.0;
+// a straight line of cones: the total-least-squares line through them, the
+// cones' largest distance from it and their extent along it
+struct ConeLine {
+  LineFit fit;
+  double max_residual = 0.0;  // m
+  double extent = 0.0;        // m
 };
 
-LineFit fit_line(const std::vector<Vec2>& p) {
-  LineFit f;
-  for (const Vec2& q : p) f.centroid += q;
-  f.centroid = f.centroid / static_cast<double>(p.size());
-  // principal axis of the scatter matrix
-  double sxx = 0.0, sxy = 0.0, syy = 0.0;
-  for (const Vec2& q : p) {
-    const Vec2 d = q - f.centroid;
-    sxx += d.x * d.x;
-    sxy += d.x * d.y;
-    syy += d.y * d.y;
-  }
-  f.direction = unit_from_angle(0.5 * std::atan2(2.0 * sxy, sxx - syy));
+ConeLine cone_line(const std::vector<Vec2>& p) {
+  ConeLine l;
+  l.fit = fit_line(p);
+  if (!l.fit.ok()) return l;
   double lo = 0.0, hi = 0.0;
   for (const Vec2& q : p) {
-    const Vec2 d = q - f.centroid;
-    f.max_residual = std::max(f.max_residual, std::abs(cross(f.direction, d)));
-    lo = std::min(lo, dot(d, f.direction));
-    hi = std::max(hi, dot(d, f.direction));
+    const Vec2 d = q - l.fit.point;
+    l.max_residual = std::max(l.max_residual, std::abs(cross(l.fit.direction, d)));
+    lo = std::min(lo, dot(d, l.fit.direction));
+    hi = std::max(hi, dot(d, l.fit.direction));
   }
-  f.extent = hi - lo;
-  return f;
+  l.extent = hi - lo;
+  return l;
 }
 
 bool looks_like_acceleration(const ConeSets& cs) {
   if (cs.blue.size() < 3 || cs.yellow.size() < 3) return false;
-  const LineFit b = fit_line(cs.blue), y = fit_line(cs.yellow);
+  const ConeLine b = cone_line(cs.blue), y = cone_line(cs.yellow);
+  if (!b.fit.ok() || !y.fit.ok()) return false;
   return b.max_residual < kLineTolerance && y.max_residual < kLineTolerance && b.extent > 30.0 &&
-         y.extent > 30.0 && std::abs(cross(b.direction, y.direction)) < std::sin(5.0 * kPi / 180.0);
+         y.extent > 30.0 && std::abs(cross(b.fit.direction, y.fit.direction)) < std::sin(5.0 * kPi / 180.0);
 }
 
 void build_acceleration(TrackModel& m, const TrackFile& f, const ConeSets& cs) {
   const LineFit b = fit_line(cs.blue), y = fit_line(cs.yellow);
   Vec2 u = unit(b.direction + (dot(b.direction, y.direction) >= 0.0 ? y.direction : -y.direction));
   // driving direction: the start yaw, else blue on the left
-  const bool blue_left_of_u = cross(u, b.centroid - y.centroid) > 0.0;
+  const bool blue_left_of_u = cross(u, b.point - y.point) > 0.0;
   if (f.start) {
     if (dot(u, f.start->heading()) < 0.0) u = -u;
-    if (cross(u, b.centroid - y.centroid) < 0.0) {
+    if (cross(u, b.point - y.point) < 0.0) {
       m.notes.push_back(f.source + ": the blue cones are on the driver's right (colours swapped relative to the rules)");
     }
   } else if (!blue_left_of_u) {
     u = -u;
   }
-  const Vec2 o = (b.centroid + y.centroid) * 0.5;
+  const Vec2 o = (b.point + y.point) * 0.5;
   auto along = [&](Vec2 p) { return dot(p - o, u); };
   auto side = [&](Vec2 p) { return cross(u, p - o); };
   auto by_along = [&](std::vector<Vec2> p) {
     std::sort(p.begin(), p.end(), [&](Vec2 a, Vec2 c) { return along(a) < along(c); });
     return p;
   };
-  const bool blue_left = cross(u, b.centroid - y.centroid) > 0.0;
+  const bool blue_left = cross(u, b.point - y.point) > 0.0;
   m.left = by_along(blue_left ? cs.blue : cs.yellow);
   m.right = by_along(blue_left ? cs.yellow : cs.blue);
   m.closed = false;
@@ -735,7 +729,7 @@ void build_acceleration(TrackModel& m, const TrackFile& f, const ConeSets& cs) {
       gates.push_back({along((g.a + g.b) * 0.5), g});
     }
   }
-  const double half = 0.5 * std::abs(side(b.centroid) - side(y.centroid));
+  const double half = 0.5 * std::abs(side(b.point) - side(y.point));
   if (gates.empty()) {
     m.gates_from = "geometry";
     const double a0 = std::min(along(m.left.front()), along(m.right.front()));
