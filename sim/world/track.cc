@@ -13,13 +13,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <numeric>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "autonomy/common/format.h"
 #include "autonomy/common/line_fit.h"
 #include "autonomy/common/polyline.h"
 
@@ -39,12 +39,6 @@ constexpr double kGatePostMargin = 1.0;       // m beyond the boundaries for gat
 constexpr double kPostGroupDistance = 3.0;    // m along the track: big orange cones closer than this form one post
 constexpr double kLineTolerance = 0.5;        // m, largest deviation of an acceleration line of cones from a straight line
 constexpr double kRingTolerance = 0.5;        // m, largest radial residual of a skidpad ring cone
-
-std::string fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
 
 Vec2 unit(Vec2 v) {
   const double n = norm(v);
