@@ -49,6 +49,19 @@ bool triangulate_and_search(const std::vector<Cone>& cone_map, const Pose2& vehi
   return true;
 }
 
+// the end every planner shares: the reference's trajectory and Ok, or
+// NoReference with the reference's reason
+PlanResult with_reference(PlanResult out, ReferenceResult ref) {
+  if (!ref.ok()) {
+    out.status = PlanStatus::NoReference;
+    out.reason = "planner: " + ref.reason;
+    return out;
+  }
+  out.trajectory = std::move(ref.trajectory);
+  out.status = PlanStatus::Ok;
+  return out;
+}
+
 }  // namespace
 
 std::optional<std::string> validate(const PathPlannerParams& p) {
@@ -119,14 +132,7 @@ PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, do
     if (clear_trajectory(out.smoothed, ref.trajectory, cone_map, params.clearance) == 0) break;
     ref = build_reference(out.smoothed, out.closed, params.reference, v_start, v_end);
   }
-  if (!ref.ok()) {
-    out.status = PlanStatus::NoReference;
-    out.reason = "planner: " + ref.reason;
-    return out;
-  }
-  out.trajectory = std::move(ref.trajectory);
-  out.status = PlanStatus::Ok;
-  return out;
+  return with_reference(std::move(out), std::move(ref));
 }
 
 PlanResult plan_acceleration(const std::vector<Cone>& cone_map, const Pose2& vehicle,
@@ -164,14 +170,7 @@ PlanResult plan_acceleration(const std::vector<Cone>& cone_map, const Pose2& veh
   out.smoothed = {start, start + dir * run};
   ReferenceResult ref =
       build_reference(out.smoothed, false, params.reference, std::max(0.0, speed), 0.0);
-  if (!ref.ok()) {
-    out.status = PlanStatus::NoReference;
-    out.reason = "planner: " + ref.reason;
-    return out;
-  }
-  out.trajectory = std::move(ref.trajectory);
-  out.status = PlanStatus::Ok;
-  return out;
+  return with_reference(std::move(out), std::move(ref));
 }
 
 }  // namespace paddock::planning
