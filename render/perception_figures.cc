@@ -18,8 +18,6 @@ namespace paddock::render {
 
 namespace {
 
-bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
-
 constexpr Rgba kNone{0, 0, 0, 0};  // no outline
 
 

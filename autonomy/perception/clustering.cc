@@ -13,8 +13,6 @@ namespace paddock::perception {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
-
 // nanoflann's view of the points being clustered (x, y)
 struct XyAdaptor {
   const std::vector<std::array<float, 2>>* pts = nullptr;

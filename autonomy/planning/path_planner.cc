@@ -11,10 +11,6 @@ namespace paddock::planning {
 
 namespace {
 
-bool finite(const Pose2& p) {
-  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.yaw);
-}
-
 // points closer than this are one point when the vehicle's position is put
 // in front of the centreline (m)
 constexpr double kSamePoint = 1e-3;

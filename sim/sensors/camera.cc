@@ -14,8 +14,6 @@ namespace paddock::sensors {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
-
 std::uint8_t to_byte(double v) {
   return static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(v, 0.0, 1.0)));
 }

@@ -12,8 +12,6 @@ namespace paddock::sensors {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
-
 const char* error_name(RTCError e) {
   switch (e) {
     case RTC_ERROR_NONE: return "none";
