@@ -15,8 +15,6 @@ namespace paddock::render {
 
 namespace {
 
-bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
-
 Vec2 normalized(Vec2 v) {
   const double n = norm(v);
   return n > 0.0 ? v / n : Vec2{0.0, 0.0};

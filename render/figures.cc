@@ -85,12 +85,6 @@ const char* cone_label(ConeColor c) {
 
 double cone_radius(ConeColor c) { return c == ConeColor::BigOrange ? 0.1425 : 0.114; }
 
-namespace {
-
-bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
-
-}  // namespace
-
 Rgba cone_color(ConeColor c) {
   switch (c) {
     case ConeColor::Blue: return {0, 90, 255, 255};

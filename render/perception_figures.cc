@@ -18,8 +18,6 @@ namespace paddock::render {
 
 namespace {
 
-bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
-
 constexpr Rgba kNone{0, 0, 0, 0};  // no outline
 
 
@@ -49,6 +47,56 @@ bool row_fits(const Page& page, const AxesFrame& f, const std::vector<LegendEntr
   const double c = 0.5 * (f.plot.left + f.plot.right);
   const double pad = page.px(kTheme.pad);
   return c - 0.5 * w >= pad - 0.5 && c + 0.5 * w <= page.width() - pad + 0.5;
+}
+
+// where the plot box may go: the page less its padding, the title, the
+// legend and the axes' margins (px, not rounded)
+struct PlotRoom {
+  double left = 0.0, top = 0.0, right = 0.0, bottom = 0.0;
+};
+
+// the axis whose range runs backwards once its ticks are chosen
+enum class Flip { X, Y };
+
+// axes laid out in three rounds: each puts the plot box in the room that the
+// previous round's tick labels left (first guess 40 px left and below, 5 px
+// right and above), chooses the ticks, flips one axis and measures the
+// margins again; place(frame, room) sets the frame's plot box and window.
+// The legend goes in a row above the plot, or right of it where the row does
+// not fit; `space` says where.
+template <class Place>
+Axes layout_axes(const Page& page, const std::string& title, const std::vector<LegendEntry>& legend,
+                 const char* x_label, const char* y_label, Flip flip, Place place, LegendSpace& space) {
+  const auto layout = [&](const LegendSpace& ls) {
+    Axes a;
+    a.x.label = x_label;
+    a.y.label = y_label;
+    const double pad = page.px(kTheme.pad);
+    const double top = pad + title_space(page, title) + ls.top;
+    Margins m;
+    m.left = m.bottom = page.px(40.0);
+    m.right = m.top = page.px(5.0);
+    for (int round = 0; round < 3; ++round) {
+      AxesFrame& f = a.frame;
+      place(f, PlotRoom{pad + m.left, top + m.top, page.width() - pad - m.right - ls.side,
+                        page.height() - pad - m.bottom});
+      a.update_ticks(page, true);
+      if (flip == Flip::X) {
+        std::swap(f.x_min, f.x_max);
+      } else {
+        std::swap(f.y_min, f.y_max);
+      }
+      m = a.margins(page);
+    }
+    return a;
+  };
+  space = legend_above(page, legend);
+  Axes ax = layout(space);
+  if (!row_fits(page, ax.frame, legend)) {
+    space = legend_right(page, legend);
+    ax = layout(space);
+  }
+  return ax;
 }
 
 // squares of side `size` px centred on the points, each in its colour, in one
@@ -164,37 +212,19 @@ Figure draw_lidar_view(const LidarViewData& d, const FigureStyle& style) {
 
   // the plot box fills the page; the window [-range/3, range] forward and
   // [-range/2, range/2] sideways grows for equal aspect. The horizontal axis is
-  // y with left positive: the frame's x range is flipped once the ticks are chosen
-  const auto layout = [&](const LegendSpace& ls) {
-    Axes a;
-    a.x.label = "y (left) [m]";
-    a.y.label = "x (forward) [m]";
-    const double pad = page.px(th.pad);
-    const double top = pad + title_space(page, d.title) + ls.top;
-    Margins m;
-    m.left = m.bottom = page.px(40.0);
-    m.right = m.top = page.px(5.0);
-    for (int round = 0; round < 3; ++round) {
-      AxesFrame& f = a.frame;
-      f.plot.left = static_cast<int>(std::lround(pad + m.left));
-      f.plot.top = static_cast<int>(std::lround(top + m.top));
-      f.plot.right = std::max(f.plot.left + 1, static_cast<int>(std::lround(page.width() - pad - m.right - ls.side)));
-      f.plot.bottom = std::max(f.plot.top + 1, static_cast<int>(std::lround(page.height() - pad - m.bottom)));
-      f.x_min = -0.5 * range, f.x_max = 0.5 * range;
-      f.y_min = -range / 3.0, f.y_max = range;
-      make_equal_aspect(f);
-      a.update_ticks(page, true);
-      std::swap(f.x_min, f.x_max);  // y grows to the left (symmetric: the same window)
-      m = a.margins(page);
-    }
-    return a;
+  // y with left positive: the frame's x range is flipped once the ticks are
+  // chosen (y grows to the left; symmetric: the same window)
+  const auto place = [&](AxesFrame& f, const PlotRoom& room) {
+    f.plot.left = static_cast<int>(std::lround(room.left));
+    f.plot.top = static_cast<int>(std::lround(room.top));
+    f.plot.right = std::max(f.plot.left + 1, static_cast<int>(std::lround(room.right)));
+    f.plot.bottom = std::max(f.plot.top + 1, static_cast<int>(std::lround(room.bottom)));
+    f.x_min = -0.5 * range, f.x_max = 0.5 * range;
+    f.y_min = -range / 3.0, f.y_max = range;
+    make_equal_aspect(f);
   };
-  LegendSpace space = legend_above(page, legend);
-  Axes ax = layout(space);
-  if (!row_fits(page, ax.frame, legend)) {
-    space = legend_right(page, legend);
-    ax = layout(space);
-  }
+  LegendSpace space;
+  Axes ax = layout_axes(page, d.title, legend, "y (left) [m]", "x (forward) [m]", Flip::X, place, space);
   const AxesFrame& f = ax.frame;
   const double scale = box_w(f.plot) / std::abs(f.x_max - f.x_min);  // px per m
   const double y_lo = std::min(f.x_min, f.x_max), y_hi = std::max(f.x_min, f.x_max);
@@ -293,41 +323,21 @@ Figure draw_camera_view(const CameraViewData& d, const FigureStyle& style) {
   // the largest plot box of the image's aspect that the margins leave, centred;
   // ticks in image pixels, then the y range flipped (v grows downwards)
   double shift = 0.0;  // px: the whole figure moved down to centre it vertically
-  const auto layout = [&](const LegendSpace& ls) {
-    Axes a;
-    a.x.label = "u [px]";
-    a.y.label = "v [px]";
-    const double pad = page.px(th.pad);
-    const double top = pad + title_space(page, d.title) + ls.top;
-    Margins m;
-    m.left = m.bottom = page.px(40.0);
-    m.right = m.top = page.px(5.0);
-    for (int round = 0; round < 3; ++round) {
-      AxesFrame& f = a.frame;
-      const double l = pad + m.left, t = top + m.top;
-      const double aw = std::max(1.0, page.width() - pad - m.right - ls.side - l);
-      const double ah = std::max(1.0, page.height() - pad - m.bottom - t);
-      const double s = std::min(aw / iw, ah / ih);
-      const int w = std::max(1, static_cast<int>(std::lround(iw * s)));
-      const int h = std::max(1, static_cast<int>(std::lround(ih * s)));
-      f.plot.left = static_cast<int>(std::lround(l + 0.5 * (aw - w)));
-      shift = std::floor(0.5 * std::max(0.0, ah - h));
-      f.plot.top = static_cast<int>(std::lround(t + shift));
-      f.plot.right = f.plot.left + w;
-      f.plot.bottom = f.plot.top + h;
-      f.x_min = 0.0, f.x_max = iw, f.y_min = 0.0, f.y_max = ih;
-      a.update_ticks(page, true);
-      std::swap(f.y_min, f.y_max);
-      m = a.margins(page);
-    }
-    return a;
+  const auto place = [&](AxesFrame& f, const PlotRoom& room) {
+    const double aw = std::max(1.0, room.right - room.left);
+    const double ah = std::max(1.0, room.bottom - room.top);
+    const double s = std::min(aw / iw, ah / ih);
+    const int w = std::max(1, static_cast<int>(std::lround(iw * s)));
+    const int h = std::max(1, static_cast<int>(std::lround(ih * s)));
+    f.plot.left = static_cast<int>(std::lround(room.left + 0.5 * (aw - w)));
+    shift = std::floor(0.5 * std::max(0.0, ah - h));
+    f.plot.top = static_cast<int>(std::lround(room.top + shift));
+    f.plot.right = f.plot.left + w;
+    f.plot.bottom = f.plot.top + h;
+    f.x_min = 0.0, f.x_max = iw, f.y_min = 0.0, f.y_max = ih;
   };
-  LegendSpace space = legend_above(page, legend);
-  Axes ax = layout(space);
-  if (!row_fits(page, ax.frame, legend)) {
-    space = legend_right(page, legend);
-    ax = layout(space);
-  }
+  LegendSpace space;
+  Axes ax = layout_axes(page, d.title, legend, "u [px]", "v [px]", Flip::Y, place, space);
   const AxesFrame& f = ax.frame;
   const auto P = [&](Vec2 uv) { return f.to_pixel(uv); };
   Canvas& c = page.canvas();

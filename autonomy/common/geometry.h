@@ -61,6 +61,11 @@ struct Pose2 {
   Vec2 inverse_transform(Vec2 p) const { return rotate(p - position(), -yaw); }
 };
 
+// no NaN and no infinity in a value: the first check of every module's input
+inline bool finite(double v) { return std::isfinite(v); }
+inline bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
+inline bool finite(const Pose2& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.yaw); }
+
 // a directed segment from a to b
 struct Segment {
   Vec2 a;

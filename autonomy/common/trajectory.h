@@ -19,6 +19,12 @@ struct TrajectoryPoint {
   Vec2 position() const { return {x, y}; }
 };
 
+// the fields a controller follows (position, heading, curvature, speed) are
+// finite; s, the point's arc-length coordinate, is not checked
+inline bool finite(const TrajectoryPoint& p) {
+  return finite(p.x) && finite(p.y) && finite(p.heading) && finite(p.curvature) && finite(p.speed);
+}
+
 // samples at a fixed arc-length spacing; a closed trajectory's last point
 // connects back to the first, and `length` then includes that closing step
 struct Trajectory {

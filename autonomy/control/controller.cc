@@ -7,12 +7,6 @@ namespace paddock::control {
 
 namespace {
 
-bool finite(double x) { return std::isfinite(x); }
-
-bool finite(const TrajectoryPoint& p) {
-  return finite(p.x) && finite(p.y) && finite(p.heading) && finite(p.curvature) && finite(p.speed);
-}
-
 SpeedModel speed_model_of(const VehicleKnowledge& v) {
   SpeedModel m;
   m.mass = v.mass;

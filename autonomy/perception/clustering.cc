@@ -13,7 +13,6 @@ namespace paddock::perception {
 
 namespace {
 
-
 // nanoflann's view of the points being clustered (x, y)
 struct XyAdaptor {
   const std::vector<std::array<float, 2>>* pts = nullptr;

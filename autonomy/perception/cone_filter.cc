@@ -10,8 +10,6 @@ namespace paddock::perception {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
-
 // the cones (ORACLES.md): base width and height; the flat top's radius
 constexpr double kSmallBaseRadius = 0.5 * 0.228, kSmallHeight = 0.325;  // m
 constexpr double kBigBaseRadius = 0.5 * 0.285, kBigHeight = 0.505;      // m

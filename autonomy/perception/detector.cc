@@ -10,7 +10,6 @@ namespace paddock::perception {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
 bool unit(double v) { return finite(v) && v >= 0.0 && v <= 1.0; }
 
 }  // namespace

@@ -10,8 +10,6 @@ namespace paddock::perception {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
-
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 }  // namespace

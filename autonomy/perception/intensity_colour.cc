@@ -9,12 +9,6 @@
 
 namespace paddock::perception {
 
-namespace {
-
-bool finite(double v) { return std::isfinite(v); }
-
-}  // namespace
-
 std::string validate(const IntensityColourParams& p) {
   std::ostringstream os;
   if (!finite(p.layer_height) || !(p.layer_height > 0.0)) {

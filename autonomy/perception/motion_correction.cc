@@ -9,7 +9,6 @@ namespace paddock::perception {
 
 namespace {
 
-
 bool usable(const hal::LidarPoint& p, int channels) {
   return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) &&
          std::isfinite(p.intensity) && static_cast<int>(p.ring) < channels;

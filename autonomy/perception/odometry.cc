@@ -9,8 +9,6 @@ namespace paddock::perception {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
-
 // sin(h) / h, its Taylor series near 0
 double sinc(double h) { return std::abs(h) < 1e-6 ? 1.0 - h * h / 6.0 : std::sin(h) / h; }
 

@@ -11,8 +11,6 @@ namespace paddock::planning {
 
 namespace {
 
-bool finite(double v) { return std::isfinite(v); }
-
 // 2 exp(-(x/sigma)^2 / 2) - 1: 1 at x = 0, -1 far away
 double bell(double x, double sigma) {
   const double r = x / sigma;

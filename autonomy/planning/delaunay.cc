@@ -19,8 +19,6 @@ using Tds = CGAL::Triangulation_data_structure_2<VertexBase>;
 using Delaunay = CGAL::Delaunay_triangulation_2<Kernel, Tds>;
 using Point = Kernel::Point_2;
 
-bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
-
 TriEdge make_edge(const std::vector<Cone>& cones, std::size_t i, std::size_t j) {
   TriEdge e;
   e.a = std::min(i, j);

@@ -70,11 +70,6 @@ Eigen::Matrix2d rotation(double yaw) {
   return r;
 }
 
-bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
-bool finite(const Covariance2& c) {
-  return std::isfinite(c.xx) && std::isfinite(c.xy) && std::isfinite(c.yy);
-}
-
 // mean and covariance of some points of a cloud
 Eigen::Matrix2d spread(const std::vector<Vec2>& pts, const std::uint32_t* idx, std::size_t n) {
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
@@ -248,7 +243,7 @@ GicpResult align(const std::vector<Vec2>& source, const std::vector<Covariance2>
   for (const auto* covs : {&source_cov, &target_cov})
     for (const Covariance2& c : *covs) {
       // finite, symmetric positive definite
-      if (!finite(c) || !(c.xx > 0.0) || !(c.xx * c.yy - c.xy * c.xy > 0.0))
+      if (!(finite(c.xx) && finite(c.xy) && finite(c.yy)) || !(c.xx > 0.0) || !(c.xx * c.yy - c.xy * c.xy > 0.0))
         return fail(r, "gicp: a covariance is not finite and positive definite");
     }
 

@@ -4,15 +4,12 @@
 #include <cmath>
 #include <utility>
 
+#include "autonomy/common/line_fit.h"
 #include "autonomy/common/polyline.h"
 
 namespace paddock::planning {
 
 namespace {
-
-bool finite(const Pose2& p) {
-  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.yaw);
-}
 
 // points closer than this are one point when the vehicle's position is put
 // in front of the centreline (m)
@@ -46,6 +43,19 @@ bool triangulate_and_search(const std::vector<Cone>& cone_map, const Pose2& vehi
     return false;
   }
   return true;
+}
+
+// the end every planner shares: the reference's trajectory and Ok, or
+// NoReference with the reference's reason
+PlanResult with_reference(PlanResult out, ReferenceResult ref) {
+  if (!ref.ok()) {
+    out.status = PlanStatus::NoReference;
+    out.reason = "planner: " + ref.reason;
+    return out;
+  }
+  out.trajectory = std::move(ref.trajectory);
+  out.status = PlanStatus::Ok;
+  return out;
 }
 
 }  // namespace
@@ -118,57 +128,7 @@ PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, do
     if (clear_trajectory(out.smoothed, ref.trajectory, cone_map, params.clearance) == 0) break;
     ref = build_reference(out.smoothed, out.closed, params.reference, v_start, v_end);
   }
-  if (!ref.ok()) {
-    out.status = PlanStatus::NoReference;
-    out.reason = "planner: " + ref.reason;
-    return out;
-  }
-  out.trajectory = std::move(ref.trajectory);
-  out.status = PlanStatus::Ok;
-  return out;
-}
-
-LineFit fit_line(const std::vector<Vec2>& points) {
-  LineFit fit;
-  if (points.size() < 2) {
-    fit.reason = "line fit: fewer than 2 points";
-    return fit;
-  }
-  // centroid and covariance
-  Vec2 c{0.0, 0.0};
-  for (const Vec2& p : points) {
-    if (!(std::isfinite(p.x) && std::isfinite(p.y))) {
-      fit.reason = "line fit: a point is not finite";
-      return fit;
-    }
-    c += p;
-  }
-  const double n = static_cast<double>(points.size());
-  c = c / n;
-  double sxx = 0.0, sxy = 0.0, syy = 0.0;
-  for (const Vec2& p : points) {
-    const Vec2 d = p - c;
-    sxx += d.x * d.x;
-    sxy += d.x * d.y;
-    syy += d.y * d.y;
-  }
-  sxx /= n;
-  sxy /= n;
-  syy /= n;
-  if (!(sxx + syy > 0.0)) {
-    fit.reason = "line fit: all points coincide";
-    return fit;
-  }
-  // the principal axis of [[sxx, sxy], [sxy, syy]] is at angle
-  // 0.5 atan2(2 sxy, sxx - syy); the smaller eigenvalue is the mean squared
-  // distance from the line: (sxx + syy)/2 - sqrt(((sxx - syy)/2)^2 + sxy^2)
-  const double angle = 0.5 * std::atan2(2.0 * sxy, sxx - syy);
-  const double half = 0.5 * (sxx - syy);
-  const double lambda_min = 0.5 * (sxx + syy) - std::sqrt(half * half + sxy * sxy);
-  fit.point = c;
-  fit.direction = unit_from_angle(angle);
-  fit.rms = std::sqrt(std::max(0.0, lambda_min));
-  return fit;
+  return with_reference(std::move(out), std::move(ref));
 }
 
 PlanResult plan_acceleration(const std::vector<Cone>& cone_map, const Pose2& vehicle,
@@ -206,14 +166,7 @@ PlanResult plan_acceleration(const std::vector<Cone>& cone_map, const Pose2& veh
   out.smoothed = {start, start + dir * run};
   ReferenceResult ref =
       build_reference(out.smoothed, false, params.reference, std::max(0.0, speed), 0.0);
-  if (!ref.ok()) {
-    out.status = PlanStatus::NoReference;
-    out.reason = "planner: " + ref.reason;
-    return out;
-  }
-  out.trajectory = std::move(ref.trajectory);
-  out.status = PlanStatus::Ok;
-  return out;
+  return with_reference(std::move(out), std::move(ref));
 }
 
 }  // namespace paddock::planning

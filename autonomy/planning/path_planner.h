@@ -68,20 +68,8 @@ struct PlanResult {
 PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, double speed,
                      const PathPlannerParams& params = {}, bool lap = true);
 
-// the least-squares line through points: orthogonal (total) least squares,
-// the principal axis of the points' covariance
-struct LineFit {
-  Vec2 point;            // the points' centroid (m)
-  Vec2 direction;        // unit direction of the line
-  double rms = 0.0;      // root mean square distance of the points from it (m)
-  std::string reason;    // empty when ok: at least 2 distinct finite points
-
-  bool ok() const { return reason.empty(); }
-};
-LineFit fit_line(const std::vector<Vec2>& points);
-
 // acceleration (the paper's line fitting): the centreline search as in
-// plan_path, a line fitted to its points, and a straight open trajectory
+// plan_path, a line fitted to its points (fit_line, autonomy/common/line_fit.h), and a straight open trajectory
 // along it from the vehicle's projection onto the line, heading the way the
 // vehicle heads, for `length` metres (default: to the farthest centreline
 // point), ending at speed 0. The search's result is kept for plots.

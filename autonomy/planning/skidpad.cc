@@ -8,8 +8,6 @@ namespace paddock::planning {
 
 namespace {
 
-bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }
-
 // a length for a message: "0.3 m"
 std::string metres(double v) {
   char buf[32];

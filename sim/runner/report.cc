@@ -6,18 +6,10 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "autonomy/common/format.h"
 #include "sim/world/track.h"
 
 namespace paddock::runner {
-namespace {
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
-
-}  // namespace
 
 std::string fmt(double v) {
   char buf[64];

@@ -1,11 +1,11 @@
 #include "sim/runner/reports.h"
 
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <array>
 #include <sstream>
 
+#include "autonomy/common/format.h"
 #include "autonomy/common/polyline.h"
 #include "autonomy/planning/path_planner.h"
 #include "sim/runner/files.h"
@@ -15,12 +15,6 @@
 
 namespace paddock::runner {
 namespace {
-
-std::string num(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
 
 struct Stats {
   double max = 0.0, mean = 0.0, std = 0.0;
@@ -79,10 +73,10 @@ std::string report_controllers(const std::string& scenario_path, const std::vect
     std::size_t first = laps.size() > 1 ? 1 : 0, n = 0;
     for (std::size_t i = first; i < laps.size(); ++i, ++n) lap += laps[i].time;
     lap = n > 0 ? lap / static_cast<double>(n) : 0.0;
-    o << "| " << row.name << " | " << num(r.tracking.itae, 1) << " | " << num(r.tracking.rms, 3) << " | "
-      << num(r.tracking.max, 3) << " | " << num(lap, 3) << " | " << (r.event.finished ? "yes" : "no") << ", "
-      << r.event.doo << ", " << r.event.oc << " | " << num(row.paper_itae, 1) << " / " << num(row.paper_rms, 3)
-      << " / " << num(row.paper_max, 3) << " / " << num(row.paper_lap, 3) << " |\n";
+    o << "| " << row.name << " | " << fixed(r.tracking.itae, 1) << " | " << fixed(r.tracking.rms, 3) << " | "
+      << fixed(r.tracking.max, 3) << " | " << fixed(lap, 3) << " | " << (r.event.finished ? "yes" : "no") << ", "
+      << r.event.doo << ", " << r.event.oc << " | " << fixed(row.paper_itae, 1) << " / " << fixed(row.paper_rms, 3)
+      << " / " << fixed(row.paper_max, 3) << " / " << fixed(row.paper_lap, 3) << " |\n";
   }
   return "Table I, lateral controllers: " + name + " (ITAE and errors per lap, averaged over the laps)\n\n" + o.str();
 }
@@ -141,7 +135,7 @@ std::string report_smoothing(const std::string& track_path) {
   for (int r = 0; r < 8; ++r) {
     o << "| " << rows[r];
     for (std::size_t m = 0; m < 4; ++m) {
-      o << " | " << num(ours[m][static_cast<std::size_t>(r)], decimals[r]) << " / " << num(methods[m].paper[r], decimals[r]);
+      o << " | " << fixed(ours[m][static_cast<std::size_t>(r)], decimals[r]) << " / " << fixed(methods[m].paper[r], decimals[r]);
     }
     o << " |\n";
   }

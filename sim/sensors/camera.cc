@@ -6,14 +6,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sim/sensors/embree_ray.h"
 #include "sim/sensors/gaussian_table.h"
 #include "sim/sensors/param_check.h"
 
 namespace paddock::sensors {
 
 namespace {
-
-bool finite(double v) { return std::isfinite(v); }
 
 std::uint8_t to_byte(double v) {
   return static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(v, 0.0, 1.0)));
@@ -355,7 +354,6 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   }
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  const auto o_x = static_cast<float>(o[0]), o_y = static_cast<float>(o[1]), o_z = static_cast<float>(o[2]);
   // the unit ray through the centre of pixel p
   const auto ray_dir = [&](std::uint32_t p, double d[3]) {
     const double a = ax_[p % static_cast<std::uint32_t>(W)], c = by_[p / static_cast<std::uint32_t>(W)];
@@ -374,20 +372,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
         valid[k] = k < n ? -1 : 0;
         double d[3];
         ray_dir(list[b + static_cast<std::size_t>(std::min(k, n - 1))], d);
-        rh.ray.org_x[k] = o_x;
-        rh.ray.org_y[k] = o_y;
-        rh.ray.org_z[k] = o_z;
-        rh.ray.dir_x[k] = static_cast<float>(d[0]);
-        rh.ray.dir_y[k] = static_cast<float>(d[1]);
-        rh.ray.dir_z[k] = static_cast<float>(d[2]);
-        rh.ray.tnear[k] = 0.0f;
-        rh.ray.tfar[k] = std::numeric_limits<float>::infinity();
-        rh.ray.time[k] = 0.0f;
-        rh.ray.mask[k] = 0xFFFFFFFFu;
-        rh.ray.id[k] = static_cast<unsigned>(k);
-        rh.ray.flags[k] = 0;
-        rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+        set_ray(rh, k, o, d, 0.0f, std::numeric_limits<float>::infinity());
       }
       rtcIntersect16(valid, world.scene(), &context, &rh);
       last_primary_rays_ += static_cast<std::size_t>(n);
@@ -488,20 +473,8 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
     float tnear = carry_t_[q];
     for (int it = 0; it < kMaxCarry; ++it) {
       RTCRayHit rh;
-      rh.ray.org_x = o_x;
-      rh.ray.org_y = o_y;
-      rh.ray.org_z = o_z;
-      rh.ray.dir_x = static_cast<float>(d[0]);
-      rh.ray.dir_y = static_cast<float>(d[1]);
-      rh.ray.dir_z = static_cast<float>(d[2]);
-      rh.ray.tnear = tnear + static_cast<float>(kCarryStep);
-      rh.ray.tfar = reach_[p];  // nothing beyond the boxes' cones matters
-      rh.ray.time = 0.0f;
-      rh.ray.mask = 0xFFFFFFFFu;
-      rh.ray.id = 0;
-      rh.ray.flags = 0;
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      // nothing beyond the boxes' cones matters
+      set_ray(rh, o, d, tnear + static_cast<float>(kCarryStep), reach_[p]);
       rtcIntersect1(world.scene(), &context, &rh);
       ++last_continued_rays_;
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;

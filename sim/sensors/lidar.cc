@@ -5,13 +5,12 @@
 #include <limits>
 #include <sstream>
 
+#include "sim/sensors/embree_ray.h"
 #include "sim/sensors/gaussian_table.h"
 
 namespace paddock::sensors {
 
 namespace {
-
-bool finite(double v) { return std::isfinite(v); }
 
 const char* error_name(RTCError e) {
   switch (e) {
@@ -368,6 +367,7 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
     const double cy = std::cos(pose.yaw), sy = std::sin(pose.yaw);
     const Vec2 origin = pose.transform({params_.mount_x, params_.mount_y});
     const double oz = world.ground_z(origin.x, origin.y) + params_.mount_z;
+    const double org[3] = {origin.x, origin.y, oz};
     const auto cu = static_cast<std::size_t>(c);
     const double ca = cos_az_[cu], sa = sin_az_[cu];
     // the column's channels in packets of 16 rays (coherent: one origin, one azimuth)
@@ -386,20 +386,8 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
         dirs[j][2] = dz;
         // pitch about the sensor's y, then the base's yaw
         const double px = cp * dx + sp * dz, pz = -sp * dx + cp * dz;
-        rh.ray.org_x[j] = static_cast<float>(origin.x);
-        rh.ray.org_y[j] = static_cast<float>(origin.y);
-        rh.ray.org_z[j] = static_cast<float>(oz);
-        rh.ray.dir_x[j] = static_cast<float>(cy * px - sy * dy);
-        rh.ray.dir_y[j] = static_cast<float>(sy * px + cy * dy);
-        rh.ray.dir_z[j] = static_cast<float>(pz);
-        rh.ray.tnear[j] = 0.0f;
-        rh.ray.tfar[j] = tfar;
-        rh.ray.time[j] = 0.0f;
-        rh.ray.mask[j] = 0xFFFFFFFFu;
-        rh.ray.id[j] = static_cast<unsigned>(j);
-        rh.ray.flags[j] = 0;
-        rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0][j] = RTC_INVALID_GEOMETRY_ID;
+        const double dir[3] = {cy * px - sy * dy, sy * px + cy * dy, pz};
+        set_ray(rh, j, org, dir, 0.0f, tfar);
       }
       rtcIntersect16(valid, world.scene(), &context, &rh);
 

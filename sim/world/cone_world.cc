@@ -34,8 +34,6 @@ constexpr double kCellSize = 2.0;
 // the grid never has more cells than this; a larger extent gets larger cells
 constexpr double kMaxCells = 1.0e6;
 
-bool finite(double v) { return std::isfinite(v); }
-
 // mean distance from the centre of a square of half side a to its points:
 // a (sqrt(2) + asinh(1)) / 3 = 0.7652 a. A square base pressing evenly on the
 // ground resists spinning with torque mu m g times this arm.

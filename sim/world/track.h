@@ -5,6 +5,12 @@
 //
 // Nothing here touches the file system: it works on text and values, and the
 // program's edge (sim/runner) reads the files.
+//
+// Where it is done: track_file.cc parses; track.cc decides the kind and
+// finishes the model, each kind built in track_circuit.cc,
+// track_acceleration.cc or track_skidpad.cc from the shared pieces of
+// track_build.h (internal); track_region.cc is the on-track test and
+// track_report.cc the check-track text.
 #include <cstddef>
 #include <optional>
 #include <stdexcept>

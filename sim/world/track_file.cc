@@ -2,12 +2,12 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "autonomy/common/format.h"
 #include "sim/world/track.h"
 
 namespace paddock::world {
@@ -47,12 +47,6 @@ std::vector<std::string_view> split_words(std::string_view s) {
     i = e;
   }
   return out;
-}
-
-std::string fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
 }
 
 // every error of a file names the file and line first

@@ -1,20 +1,14 @@
 // the human-readable summary of a track file that `paddock check-track` prints.
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 #include <string>
 
+#include "autonomy/common/format.h"
 #include "sim/world/track.h"
 
 namespace paddock::world {
 
 namespace {
-
-std::string fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
 
 std::string point(Vec2 p) { return "(" + fixed(p.x, 2) + ", " + fixed(p.y, 2) + ")"; }
 

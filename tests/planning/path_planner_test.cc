@@ -535,36 +535,7 @@ TEST(PathPlanner, ALapNotWantedYetIsAnOpenPathAlongIt) {
   EXPECT_NEAR(open.trajectory.points.front().speed, 5.0, 0.5);
 }
 
-// ---- acceleration: the line fit ----------------------------------------------------------
-
-TEST(PathPlanner, FitLineIsTotalLeastSquares) {
-  // exact points on a slanted line
-  std::vector<Vec2> pts;
-  for (int i = 0; i < 10; ++i) pts.push_back({1.0 + 2.0 * i, -3.0 + 1.0 * i});
-  LineFit f = fit_line(pts);
-  ASSERT_TRUE(f.ok());
-  EXPECT_NEAR(std::abs(cross(f.direction, Vec2{2.0, 1.0} / std::sqrt(5.0))), 0.0, 1e-12);
-  EXPECT_NEAR(f.rms, 0.0, 1e-9);
-  EXPECT_NEAR(f.point.x, 10.0, 1e-12);
-  EXPECT_NEAR(f.point.y, 1.5, 1e-12);
-  // points alternately 0.2 m either side of the x axis: rms 0.2, along x
-  pts.clear();
-  for (int i = 0; i < 20; ++i) pts.push_back({1.0 * i, i % 2 ? 0.2 : -0.2});
-  f = fit_line(pts);
-  ASSERT_TRUE(f.ok());
-  EXPECT_NEAR(std::abs(f.direction.x), 1.0, 1e-3);
-  EXPECT_NEAR(f.rms, 0.2, 1e-3);
-  // a vertical line (ordinary least squares y(x) would fail here)
-  pts = {{2.0, 0.0}, {2.0, 1.0}, {2.0, 5.0}};
-  f = fit_line(pts);
-  ASSERT_TRUE(f.ok());
-  EXPECT_NEAR(std::abs(f.direction.y), 1.0, 1e-12);
-  // degenerate input
-  EXPECT_FALSE(fit_line({}).ok());
-  EXPECT_FALSE(fit_line({{1.0, 1.0}}).ok());
-  EXPECT_FALSE(fit_line({{1.0, 1.0}, {1.0, 1.0}, {1.0, 1.0}}).ok());
-  EXPECT_FALSE(fit_line({{1.0, 1.0}, {std::nan(""), 1.0}}).ok());
-}
+// ---- acceleration ----------------------------------------------------------------------
 
 TEST(PathPlanner, AccelerationIsAStraightLineDownTheLane) {
   for (const std::string name : {"acceleration", "acceleration_amz_fssim"}) {
