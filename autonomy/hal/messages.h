@@ -104,8 +104,24 @@ struct CameraFrame {
   std::vector<CameraInstance> instances;
 };
 
+// one box a cone detector drew on a camera image, in pixels (x right, y
+// down, row 0 at the top; pixel (i, j) covers [i, i+1) x [j, j+1))
+struct CameraBox {
+  double x_min = 0.0, y_min = 0.0, x_max = 0.0, y_max = 0.0;  // px
+  ConeColor color = ConeColor::Unknown;                       // the detector's class
+  double confidence = 1.0;                                    // -, [0, 1]
+};
+
+// the boxes a cone detector node (the paper's YOLOv5 on the car's computer)
+// found on one camera frame, posted after the frame's exposure
+struct CameraDetections {
+  TimeNs stamp = 0;           // the frame's exposure time
+  int width = 0, height = 0;  // px, the image the boxes are drawn on
+  std::vector<CameraBox> boxes;
+};
+
 using SensorMessage = std::variant<StateEstimate, ResSignal, ConeDetections, Imu, WheelSpeeds, SteeringAngle,
-                                   LidarScan, CameraFrame>;
+                                   LidarScan, CameraFrame, CameraDetections>;
 
 // the stack's command to the car's low-level controllers
 struct ActuatorCommand {
