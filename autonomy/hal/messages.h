@@ -84,24 +84,12 @@ struct LidarScan {
   std::vector<LidarPoint> points;
 };
 
-// simulation's annotation of one cone seen by the camera (a labelled data
-// set's box label); a hardware camera gives none
-struct CameraInstance {
-  std::int32_t id = -1;                  // the value of its pixels in CameraFrame::labels
-  ConeColor color = ConeColor::Unknown;  // its class
-  double range = 0.0;                    // m, from the camera's optical centre to the cone
-  double visible_fraction = 1.0;         // -, visible pixels / pixels it would cover unoccluded
-};
-
-// one camera image (global shutter), triggered by the LiDAR once per rotation
+// one camera image (global shutter), triggered by the LiDAR once per rotation:
+// what the camera driver gives, nothing more
 struct CameraFrame {
   TimeNs stamp = 0;  // exposure time
   int width = 0, height = 0;
   std::vector<std::uint8_t> rgb;  // row-major, 3 bytes a pixel, row 0 at the top
-  // simulation only (empty from hardware): per pixel the id of the cone
-  // instance it shows, -1 for none; and the instances
-  std::vector<std::int32_t> labels;
-  std::vector<CameraInstance> instances;
 };
 
 // one box a cone detector drew on a camera image, in pixels (x right, y

@@ -9,6 +9,7 @@
 
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
+#include "sim/sensors/annotation_detector.h"
 #include "sim/sensors/cone_sensor.h"
 #include "sim/sensors/camera.h"
 #include "sim/sensors/imu.h"
@@ -65,8 +66,9 @@ struct Scenario {
   sensors::SteeringSensorParams steering_sensor;  // [steering_sensor]
   sensors::LidarParams lidar;             // [lidar]: the rotating LiDAR of perception = lidar, lidar_camera
   sensors::CameraParams camera;           // [camera]: the camera of perception = lidar_camera
-  // [perception], [detector]: the stack's perception front (perception =
-  // lidar | lidar_camera); its calibration is filled from [lidar] and [camera]
+  sensors::DetectorParams detector;       // [detector]: the camera's detector node (its error model)
+  // [perception]: the stack's perception front (perception = lidar |
+  // lidar_camera); its calibration is filled from [lidar] and [camera]
   perception::PerceptionParams perception;
   sensors::GroundParams ground;           // [ground]: the ground's shape, as the sensors see it
   vehicle::VehicleParams vehicle;

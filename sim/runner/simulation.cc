@@ -46,7 +46,10 @@ std::vector<Vec2> skidpad_path(const world::SkidpadGeometry& g) {
   return p;
 }
 
-PerceptionSnapshot take_snapshot(const perception::Perception& p, const Pose2& pose, const world::ConeWorld& cones) {
+// frame: the camera frame the runner rendered last (the one of the scan the
+// stack just processed), or null
+PerceptionSnapshot take_snapshot(const perception::Perception& p, const hal::CameraFrame* frame, const Pose2& pose,
+                                 const world::ConeWorld& cones) {
   const perception::PerceptionFrame& f = p.last();
   PerceptionSnapshot s;
   s.t = to_seconds(f.output.stamp);
@@ -59,13 +62,12 @@ PerceptionSnapshot take_snapshot(const perception::Perception& p, const Pose2& p
     const Vec2 local = pose.inverse_transform(cones.cone_position(i));
     if (norm(local) <= 40.0) s.truth.push_back({local, cones.cone(i).color});
   }
-  if (f.camera_used && p.camera_frame()) {
-    const hal::CameraFrame& frame = *p.camera_frame();
+  if (f.camera_used && frame != nullptr && frame->stamp == f.camera_stamp) {
     s.camera = true;
-    s.width = frame.width;
-    s.height = frame.height;
-    s.rgb = frame.rgb;
-    for (const perception::BoundingBox& b : f.detection.boxes) s.boxes.push_back({b.x_min, b.y_min, b.x_max, b.y_max, b.color});
+    s.width = frame->width;
+    s.height = frame->height;
+    s.rgb = frame->rgb;
+    for (const perception::BoundingBox& b : f.detections.boxes) s.boxes.push_back({b.x_min, b.y_min, b.x_max, b.y_max, b.color});
     for (const perception::FusedCone& c : f.fusion.cones) {
       if (!c.projected) continue;
       (c.source == perception::FusionSource::Dropped ? s.dropped : s.projected).push_back({c.pixel.x(), c.pixel.y()});
@@ -188,7 +190,9 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
   if (raw_perception) {
     std::optional<sensors::CameraParams> camera;
     if (sc.autonomy.perception == stack::PerceptionMode::LidarCamera) camera = sc.camera;
-    raw = std::make_unique<RawSensors>(sc.lidar, sc.ground, camera, sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 5);
+    raw = std::make_unique<RawSensors>(sc.lidar, sc.ground, camera, sc.detector,
+                                       sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 5,
+                                       sc.scenario.seed * 0x9E3779B97F4A7C15ULL + 6);
   }
 
   // perception metrics: each frame the stack got, against the truth of its instant
@@ -277,7 +281,8 @@ RunResult run(const Scenario& sc, const world::TrackModel& track) {
       const long frames_before = stack.detection_frames();
       stack.tick(now, hal);
       if (snap_pending && stack.detection_frames() > frames_before) {
-        res.snapshot = take_snapshot(*stack.perception(), truth_poses.at(stack.last_detections().stamp), cones);
+        res.snapshot = take_snapshot(*stack.perception(), raw->camera_frame(),
+                                     truth_poses.at(stack.last_detections().stamp), cones);
         stack.perception()->set_keep_points(false);
       }
       if (stack.detection_frames() > scored_frames) {
