@@ -1,6 +1,9 @@
 #pragma once
 // what crosses the HAL: timestamped sensor messages in, actuator commands out.
-// The sim back end and the hardware back end produce exactly these.
+// The sim back end and the hardware back end produce exactly these, so every
+// field is one a part of the car fills (or, for a command, takes): nothing
+// that only a simulator knows (tests/hal/messages_test.cc names the part
+// behind each field and fails on a field without one).
 #include <array>
 #include <cstdint>
 #include <variant>
