@@ -8,8 +8,8 @@
 //   BM_CameraFrameBumpy  the same on a bumpy ground (height field: the boxes'
 //                    pixels plus a ray per 4 x 4 tile)
 //   BM_CameraFrameNoisy  the same with 2 levels of pixel noise
-//   BM_Detector      AnnotationDetector::detect on such a frame (a pass over
-//                    the labels, the error model)
+//   BM_Detector      sensors::AnnotationDetector::detect on such a frame and
+//                    its annotation (a pass over the labels, the error model)
 //   BM_Fusion        fuse() of 60 candidates (the cones within 20 m ahead and
 //                    a few fakes) with that frame's boxes
 // Counters: mean and p99 (ms) of the timed calls, rays cast, instances.
@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "autonomy/perception/detector.h"
 #include "autonomy/perception/fusion.h"
 #include "bench/bench_scenes.h"
+#include "sim/sensors/annotation_detector.h"
 #include "sim/sensors/camera.h"
 #include "sim/world/track.h"
 
@@ -60,16 +60,17 @@ void camera_frames(benchmark::State& state, const sensors::GroundParams& ground,
   sensors::Camera camera(params, 1);
   const std::vector<Pose2> poses = poses_along(track, 50);
   hal::CameraFrame frame;
+  sensors::CameraAnnotation annotation;
   std::vector<double> ms;
   std::size_t k = 0, rays = 0, instances = 0;
   for (auto _ : state) {
     const Pose2& pose = poses[k++ % poses.size()];
     const auto t0 = std::chrono::steady_clock::now();
-    camera.render(world, pose, 0, frame);
+    camera.render(world, pose, 0, frame, annotation);
     const auto t1 = std::chrono::steady_clock::now();
     ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     rays += camera.last_primary_rays() + camera.last_continued_rays();
-    instances += frame.instances.size();
+    instances += annotation.instances.size();
     benchmark::DoNotOptimize(frame.rgb.data());
   }
   report(state, ms);
@@ -99,7 +100,7 @@ BENCHMARK(BM_CameraFrameNoisy)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 // a frame from the start pose of the track, for the detector and the fusion
 struct Scene {
   world::TrackModel track = fsg_2023();
-  hal::CameraFrame frame;
+  sensors::AnnotatedFrame shot;
   perception::CameraCalibration calib;
   Pose2 pose;
 };
@@ -109,29 +110,29 @@ Scene start_scene() {
   const sensors::LidarWorld world(s.track.cones);
   sensors::Camera camera(sensors::CameraParams{}, 1);
   s.pose = poses_along(s.track, 50)[3];
-  s.frame = camera.render(world, s.pose, 0);
+  s.shot = camera.render(world, s.pose, 0);
   s.calib = camera.calibration();
   return s;
 }
 
 void BM_Detector(benchmark::State& state) {
   const Scene s = start_scene();
-  perception::AnnotationDetector detector(perception::DetectorParams{}, 1);
+  sensors::AnnotationDetector detector(sensors::DetectorParams{}, 1);
   std::size_t boxes = 0;
   for (auto _ : state) {
-    const perception::DetectorResult r = detector.detect(s.frame);
-    boxes = r.boxes.size();
-    benchmark::DoNotOptimize(r.boxes.data());
+    const sensors::AnnotationDetection r = detector.detect(s.shot.frame, s.shot.annotation);
+    boxes = r.detections.boxes.size();
+    benchmark::DoNotOptimize(r.detections.boxes.data());
   }
-  state.counters["instances"] = static_cast<double>(s.frame.instances.size());
+  state.counters["instances"] = static_cast<double>(s.shot.annotation.instances.size());
   state.counters["boxes"] = static_cast<double>(boxes);
 }
 BENCHMARK(BM_Detector)->Unit(benchmark::kMicrosecond);
 
 void BM_Fusion(benchmark::State& state) {
   const Scene s = start_scene();
-  perception::AnnotationDetector detector(perception::DetectorParams{}, 1);
-  const perception::DetectorResult det = detector.detect(s.frame);
+  sensors::AnnotationDetector detector(sensors::DetectorParams{}, 1);
+  const std::vector<hal::CameraBox> boxes = detector.detect(s.shot.frame, s.shot.annotation).detections.boxes;
   // the cones within 20 m (base frame, mid-height), then fakes between them
   std::vector<perception::ConeCandidate> cands;
   for (const Cone& c : s.track.cones) {
@@ -141,12 +142,12 @@ void BM_Fusion(benchmark::State& state) {
   for (int k = 0; cands.size() < 60; ++k) cands.push_back({Eigen::Vector3d(3.0 + k, 0.0, 0.16), ConeColor::Unknown, 10});
   int kept = 0;
   for (auto _ : state) {
-    const perception::FusionResult r = perception::fuse(cands, det.boxes, s.calib);
+    const perception::FusionResult r = perception::fuse(cands, boxes, s.calib);
     kept = r.from_camera + r.from_lidar;
     benchmark::DoNotOptimize(r.cones.data());
   }
   state.counters["candidates"] = static_cast<double>(cands.size());
-  state.counters["boxes"] = static_cast<double>(det.boxes.size());
+  state.counters["boxes"] = static_cast<double>(boxes.size());
   state.counters["kept"] = kept;
 }
 BENCHMARK(BM_Fusion)->Unit(benchmark::kMicrosecond);

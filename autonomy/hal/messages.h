@@ -1,6 +1,9 @@
 #pragma once
 // what crosses the HAL: timestamped sensor messages in, actuator commands out.
-// The sim back end and the hardware back end produce exactly these.
+// The sim back end and the hardware back end produce exactly these, so every
+// field is one a part of the car fills (or, for a command, takes): nothing
+// that only a simulator knows (tests/hal/messages_test.cc names the part
+// behind each field and fails on a field without one).
 #include <array>
 #include <cstdint>
 #include <variant>
@@ -84,28 +87,32 @@ struct LidarScan {
   std::vector<LidarPoint> points;
 };
 
-// simulation's annotation of one cone seen by the camera (a labelled data
-// set's box label); a hardware camera gives none
-struct CameraInstance {
-  std::int32_t id = -1;                  // the value of its pixels in CameraFrame::labels
-  ConeColor color = ConeColor::Unknown;  // its class
-  double range = 0.0;                    // m, from the camera's optical centre to the cone
-  double visible_fraction = 1.0;         // -, visible pixels / pixels it would cover unoccluded
-};
-
-// one camera image (global shutter), triggered by the LiDAR once per rotation
+// one camera image (global shutter), triggered by the LiDAR once per rotation:
+// what the camera driver gives, nothing more
 struct CameraFrame {
   TimeNs stamp = 0;  // exposure time
   int width = 0, height = 0;
   std::vector<std::uint8_t> rgb;  // row-major, 3 bytes a pixel, row 0 at the top
-  // simulation only (empty from hardware): per pixel the id of the cone
-  // instance it shows, -1 for none; and the instances
-  std::vector<std::int32_t> labels;
-  std::vector<CameraInstance> instances;
+};
+
+// one box a cone detector drew on a camera image, in pixels (x right, y
+// down, row 0 at the top; pixel (i, j) covers [i, i+1) x [j, j+1))
+struct CameraBox {
+  double x_min = 0.0, y_min = 0.0, x_max = 0.0, y_max = 0.0;  // px
+  ConeColor color = ConeColor::Unknown;                       // the detector's class
+  double confidence = 1.0;                                    // -, [0, 1]
+};
+
+// the boxes a cone detector node (the paper's YOLOv5 on the car's computer)
+// found on one camera frame, posted after the frame's exposure
+struct CameraDetections {
+  TimeNs stamp = 0;           // the frame's exposure time
+  int width = 0, height = 0;  // px, the image the boxes are drawn on
+  std::vector<CameraBox> boxes;
 };
 
 using SensorMessage = std::variant<StateEstimate, ResSignal, ConeDetections, Imu, WheelSpeeds, SteeringAngle,
-                                   LidarScan, CameraFrame>;
+                                   LidarScan, CameraFrame, CameraDetections>;
 
 // the stack's command to the car's low-level controllers
 struct ActuatorCommand {

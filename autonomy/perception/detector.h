@@ -4,16 +4,14 @@
 // orange, big orange; unknown for FSOCO's "unknown cone").
 //
 // ConeDetector is the interface a real network (the paper's YOLOv5 trained on
-// FSOCO) implements on the car. AnnotationDetector stands in for it in the
-// simulator: it reads the frame's annotation (hal::CameraFrame::labels and
-// ::instances), takes the tight pixel box of every instance, and spoils it
-// with a seeded error model of a network (DetectorParams): misses that grow
-// with range and occlusion, class confusion, box jitter, a smallest box.
+// FSOCO) implements on the car, for a Perception that runs it on the camera
+// frames itself. A detector node of its own posts its boxes through the HAL
+// instead (hal::CameraDetections); the simulator's stand-in, which reads the
+// simulation's annotation of a frame, is such a node
+// (sim/sensors/annotation_detector.h).
 //
 // Pure library: no I/O, no clock, no simulator types. detect() never throws;
 // a frame it cannot use gives ok = false and a reason.
-#include <cstdint>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -33,91 +31,5 @@ class ConeDetector {
   virtual ~ConeDetector();
   virtual DetectorResult detect(const hal::CameraFrame& frame) = 0;
 };
-
-// the error model. Each annotated instance (a cone with >= 1 labelled pixel)
-// is missed with
-//   p_miss = 1 - (1 - p_range(range)) (1 - p_occlusion(visible_fraction))
-//   p_range(r) = p_miss_near + (1 - p_miss_near) s(x),
-//     x = clamp((r - range_full) / (range_max - range_full), 0, 1), s(x) = 3x^2 - 2x^3
-//     (flat p_miss_near up to range_full, rising smoothly to 1 at range_max)
-//   p_occlusion(f) = 1 for f < visible_min, (visible_full - f) / (visible_full
-//     - visible_min) in between, 0 from visible_full up
-// and is dropped outright when its tight box is less than min_box_height px
-// tall. A detected cone's class flips blue <-> yellow with p_confuse_blue_yellow
-// and small <-> big orange with p_confuse_orange_size; its box edges move by
-// independent N(0, (box_jitter w)^2) (left, right) and N(0, (box_jitter h)^2)
-// (top, bottom), w and h the tight box's size, then are clamped to the image.
-// confidence = 1 - p_miss.
-//
-// The defaults are for the simulator's default camera (800 x 500 px, fx = 400
-// px, sim/sensors/camera.h), where a small cone (0.325 m) is f h / r = 130 / r
-// px tall: 10.8 px at 12 m, 6.5 px at 20 m. A YOLOv5 at this input size finds
-// nearly every whole cone of 10 px and up and few below 6 px (FS teams report
-// reliable detection to 15-20 m on ~1 MP images); the curve below gives 2 %
-// to 12 m, 9.3 % at 15 m, 43 % at 20 m, 1 at 30 m.
-struct DetectorParams {
-  double p_miss_near = 0.02;  // -, in [0, 1]
-  double range_full = 12.0;   // m, >= 0
-  double range_max = 30.0;    // m, > range_full
-  // a cone less than 30 % visible is not found, one 70 % visible always is
-  // (as far as occlusion goes): YOLO finds well-separated half-hidden cones
-  // about half the time
-  double visible_min = 0.3;   // -, in [0, 1]
-  double visible_full = 0.7;  // -, in [visible_min, 1], > visible_min unless both 1
-  // blue and yellow look alike in low light / against the sun; the two
-  // oranges differ mainly in size
-  double p_confuse_blue_yellow = 0.01;  // -, in [0, 1]
-  double p_confuse_orange_size = 0.05;  // -, in [0, 1]
-  // box edge noise std, as a fraction of the box's size (3 %: about a pixel
-  // on a 30 px cone, YOLO's typical IoU of 0.85-0.9 on cones)
-  double box_jitter = 0.03;  // -, >= 0
-  // boxes smaller than this are never found (YOLOv5's smallest anchors)
-  double min_box_height = 6.0;  // px, >= 0
-};
-
-// "" when every field is usable, else the first problem, starting with the
-// field name
-std::string validate(const DetectorParams& p);
-
-// p_miss of the model above, for an instance at `range` (m) with
-// `visible_fraction` (-) visible
-double miss_probability(const DetectorParams& p, double range, double visible_fraction);
-
-// the tight box of an instance's labelled pixels: [i_min, i_max + 1) x
-// [j_min, j_max + 1) in px (pixel (i, j) covers [i, i+1) x [j, j+1))
-struct TightBox {
-  std::int32_t id = -1;
-  int i_min = 0, i_max = -1, j_min = 0, j_max = -1;
-  int pixels = 0;
-};
-
-class AnnotationDetector : public ConeDetector {
- public:
-  // throws std::invalid_argument when validate(params) fails. The seed starts
-  // the detector's own random stream (std::mt19937_64).
-  AnnotationDetector(const DetectorParams& params, std::uint64_t seed);
-
-  // the boxes of the frame's annotated instances, in the order of
-  // frame.instances (missed and too small ones left out). Not ok: a frame
-  // with no pixels, sizes that disagree (rgb != 3 w h, labels != w h), labels
-  // < -1 or without an instance, duplicate or negative instance ids; and a
-  // frame without annotation (a hardware frame: labels empty), which this
-  // detector cannot see into. Each instance takes the same number of draws
-  // from the stream whatever becomes of it.
-  DetectorResult detect(const hal::CameraFrame& frame) override;
-
-  const DetectorParams& params() const { return params_; }
-
- private:
-  DetectorParams params_;
-  std::mt19937_64 rng_;
-  std::uniform_real_distribution<double> uniform_{0.0, 1.0};
-  std::normal_distribution<double> normal_{0.0, 1.0};
-};
-
-// the tight boxes of the frame's instances (in frame.instances' order, one
-// per instance, pixels = 0 for one with no labelled pixel); "" in *error or
-// the reason the frame cannot be read (then the result is empty)
-std::vector<TightBox> tight_boxes(const hal::CameraFrame& frame, std::string* error);
 
 }  // namespace paddock::perception

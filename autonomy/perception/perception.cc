@@ -1,6 +1,7 @@
 #include "autonomy/perception/perception.h"
 
 #include <cmath>
+#include <string>
 #include <stdexcept>
 #include <utility>
 
@@ -9,7 +10,6 @@ namespace paddock::perception {
 std::string validate(const PerceptionParams& p) {
   if (std::string why = validate(p.odometry); !why.empty()) return "odometry." + why;
   if (std::string why = validate(p.lidar); !why.empty()) return "lidar." + why;
-  if (std::string why = validate(p.detector); !why.empty()) return "detector." + why;
   if (std::string why = validate(p.fusion); !why.empty()) return "fusion." + why;
   if (p.use_camera) {
     const CameraCalibration& c = p.camera;
@@ -29,12 +29,22 @@ const PerceptionParams& checked(const PerceptionParams& p) {
 }
 }  // namespace
 
-Perception::Perception(const PerceptionParams& params, std::uint64_t seed)
-    : params_(checked(params)), odometry_(params.odometry), pipeline_(params.lidar) {
-  if (params_.use_camera) detector_ = std::make_unique<AnnotationDetector>(params_.detector, seed);
-}
+Perception::Perception(const PerceptionParams& params, std::unique_ptr<ConeDetector> detector)
+    : params_(checked(params)), odometry_(params.odometry), pipeline_(params.lidar), detector_(std::move(detector)) {}
 
-void Perception::add(hal::CameraFrame frame) { frame_ = std::move(frame); }
+void Perception::add(hal::CameraDetections detections) { camera_ = CameraInput{std::move(detections), ""}; }
+
+void Perception::add(const hal::CameraFrame& frame) {
+  // no network of its own (or no camera in this mode): the boxes come as detections messages
+  if (!detector_ || !params_.use_camera) return;
+  DetectorResult r = detector_->detect(frame);
+  CameraInput in{{frame.stamp, frame.width, frame.height, std::move(r.boxes)}, ""};
+  if (!r.ok) {
+    in.detections.boxes.clear();
+    in.failure = r.reason.empty() ? "no reason given" : r.reason;
+  }
+  camera_ = std::move(in);
+}
 
 const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
   ++stats_.scans;
@@ -42,7 +52,7 @@ const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
   last_.camera_used = false;
   last_.camera_note.clear();
   last_.camera_stamp = 0;
-  last_.detection = {};
+  last_.detections = {};
   last_.fusion = {};
   hal::ConeDetections& out = last_.output;
   out.stamp = last_.lidar.stamp;
@@ -54,19 +64,26 @@ const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
   if (!last_.lidar.corrected) ++stats_.scans_uncorrected;
   const std::vector<ConeCandidate>& cands = last_.lidar.cones;
 
-  // the camera frame exposed during this rotation, if the mode has a camera
+  // the detections of the camera frame exposed during this rotation, if the mode has a camera
   const TimeNs tol = from_seconds(params_.camera_sync_tolerance);
+  const CameraInput* cam = nullptr;
   if (params_.use_camera) {
-    if (!frame_) {
-      last_.camera_note = "no camera frame";
-    } else if (frame_->stamp < scan.stamp - tol || frame_->stamp > scan.end + tol) {
-      last_.camera_note = "no camera frame of this rotation";
+    const CameraCalibration& calib = params_.camera;
+    if (!camera_) {
+      last_.camera_note = "no camera detections";
+    } else if (camera_->detections.stamp < scan.stamp - tol || camera_->detections.stamp > scan.end + tol) {
+      last_.camera_note = "no camera detections of this rotation";
+    } else if (!camera_->failure.empty()) {
+      last_.camera_note = "detector: " + camera_->failure;
+    } else if (camera_->detections.width != calib.width || camera_->detections.height != calib.height) {
+      last_.camera_note = "camera detections on a " + std::to_string(camera_->detections.width) + " x " +
+                          std::to_string(camera_->detections.height) + " image, the calibration's is " +
+                          std::to_string(calib.width) + " x " + std::to_string(calib.height);
     } else {
-      last_.detection = detector_->detect(*frame_);
-      if (!last_.detection.ok) last_.camera_note = "detector: " + last_.detection.reason;
+      cam = &*camera_;
     }
   }
-  if (!params_.use_camera || !last_.detection.ok) {
+  if (cam == nullptr) {
     if (params_.use_camera) ++stats_.scans_without_camera;
     for (const ConeCandidate& c : cands) out.cones.push_back({{c.centre.x(), c.centre.y()}, c.color});
     return out;
@@ -75,9 +92,10 @@ const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
   // the candidates at the camera's exposure: the base pose at the scan's
   // reference time seen from the base at the exposure (planar motion)
   last_.camera_used = true;
-  last_.camera_stamp = frame_->stamp;
+  last_.camera_stamp = cam->detections.stamp;
+  last_.detections = cam->detections;
   std::vector<ConeCandidate> at_camera = cands;
-  if (const std::optional<Pose2> rel = odometry_.relative(frame_->stamp, out.stamp)) {
+  if (const std::optional<Pose2> rel = odometry_.relative(cam->detections.stamp, out.stamp)) {
     for (ConeCandidate& c : at_camera) {
       const Vec2 p = rel->transform({c.centre.x(), c.centre.y()});
       c.centre.x() = p.x;
@@ -86,7 +104,7 @@ const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
   } else {
     last_.camera_note = "no odometry between the exposure and the scan: fused unmoved";
   }
-  last_.fusion = fuse(at_camera, last_.detection.boxes, params_.camera, params_.fusion);
+  last_.fusion = fuse(at_camera, last_.detections.boxes, params_.camera, params_.fusion);
   for (std::size_t i = 0; i < cands.size(); ++i) {
     const FusedCone& f = last_.fusion.cones[i];
     if (!f.kept) {

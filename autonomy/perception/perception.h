@@ -1,6 +1,6 @@
 #pragma once
 // the perception front of the stack (the paper's section "Perception"): raw
-// LiDAR scans and camera frames in, cone detections out.
+// LiDAR scans and the camera detector's boxes in, cone detections out.
 //
 //   odometry  IMU yaw rate + wheel speeds, dead-reckoned over the last seconds
 //   LiDAR     motion correction -> ground removal -> clustering ->
@@ -8,16 +8,18 @@
 //             (LidarPipeline): cone candidates in the base frame at the end of
 //             the rotation
 //   camera    the detector's boxes on the frame the LiDAR triggered during
-//             that rotation (ConeDetector; the AnnotationDetector here)
+//             that rotation: posted through the HAL by a detector node
+//             (hal::CameraDetections; in the simulator its annotation
+//             detector), or found by a ConeDetector given to Perception,
+//             which then runs it on the camera frames itself
 //   fusion    each candidate moved by the odometry to the base frame at the
 //             camera's exposure, projected through K [R|T]: in a box -> the
 //             box's colour, in view but in no box -> dropped, out of view ->
 //             the LiDAR's colour (fuse)
 //
-// use_camera = false is the LiDAR-only mode (perception = lidar). A missing or
-// unusable camera frame degrades a lidar_camera scan to LiDAR only for that
-// scan (counted in the stats), it never stops the output.
-#include <cstdint>
+// use_camera = false is the LiDAR-only mode (perception = lidar). Missing or
+// unusable camera detections degrade a lidar_camera scan to LiDAR only for
+// that scan (counted in the stats), they never stop the output.
 #include <memory>
 #include <optional>
 #include <string>
@@ -36,10 +38,9 @@ struct PerceptionParams {
   OdometryParams odometry;
   LidarPipelineParams lidar;  // its calibration: the LiDAR's mounting and beams
   CameraCalibration camera;   // K and T_camera_base
-  DetectorParams detector;
   FusionParams fusion;
-  // a camera frame serves the scan during whose rotation it was exposed, give
-  // or take this much (s)
+  // a camera frame's detections serve the scan during whose rotation the
+  // frame was exposed, give or take this much (s)
   double camera_sync_tolerance = 0.02;
 };
 
@@ -49,10 +50,10 @@ std::string validate(const PerceptionParams& p);
 // what the last scan went through, for plots and diagnostics
 struct PerceptionFrame {
   LidarResult lidar;
-  bool camera_used = false;            // the scan was fused with a camera frame
+  bool camera_used = false;            // the scan was fused with a camera frame's detections
   std::string camera_note;             // why not, when the mode has a camera
   TimeNs camera_stamp = 0;             // the fused frame's exposure (camera_used), else 0
-  DetectorResult detection;            // the camera frame's boxes (camera_used)
+  hal::CameraDetections detections;    // the fused frame's boxes (camera_used)
   FusionResult fusion;                 // per LiDAR candidate (camera_used)
   hal::ConeDetections output;
 };
@@ -67,14 +68,18 @@ struct PerceptionStats {
 
 class Perception {
  public:
-  // throws std::invalid_argument when validate(params) fails; the seed starts
-  // the detector's random stream
-  Perception(const PerceptionParams& params, std::uint64_t seed);
+  // throws std::invalid_argument when validate(params) fails. detector: a
+  // network run on the camera frames (add(CameraFrame)), or none when a
+  // detector node posts its boxes (add(CameraDetections))
+  explicit Perception(const PerceptionParams& params, std::unique_ptr<ConeDetector> detector = nullptr);
 
   void add(const hal::Imu& imu) { odometry_.add(imu); }
   void add(const hal::WheelSpeeds& wheels) { odometry_.add(wheels); }
-  // the newest camera frame is kept until a scan uses it
-  void add(hal::CameraFrame frame);
+  // the newest camera detections are kept for the scan of their rotation
+  void add(hal::CameraDetections detections);
+  // with a detector of its own: its boxes on the frame, kept as the newest
+  // detections (or, when it fails, the reason); without one the frame is not looked at
+  void add(const hal::CameraFrame& frame);
 
   // one rotation -> the cones, base frame at the scan's reference time (its end)
   const hal::ConeDetections& process(const hal::LidarScan& scan);
@@ -83,15 +88,19 @@ class Perception {
   void set_keep_points(bool keep) { params_.lidar.keep_points = keep; pipeline_ = LidarPipeline(params_.lidar); }
   const PerceptionFrame& last() const { return last_; }
   const PerceptionStats& stats() const { return stats_; }
-  // the newest camera frame received (for plots), if any
-  const std::optional<hal::CameraFrame>& camera_frame() const { return frame_; }
 
  private:
+  // the newest camera input: a frame's detections, or why the own detector found none on it
+  struct CameraInput {
+    hal::CameraDetections detections;
+    std::string failure;  // "" when the detections are usable
+  };
+
   PerceptionParams params_;
   Odometry odometry_;
   LidarPipeline pipeline_;
   std::unique_ptr<ConeDetector> detector_;
-  std::optional<hal::CameraFrame> frame_;
+  std::optional<CameraInput> camera_;
   PerceptionFrame last_;
   PerceptionStats stats_;
 };

@@ -12,6 +12,7 @@
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
 #include "autonomy/hal/lidar_layout.h"
+#include "autonomy/hal/messages.h"
 
 namespace paddock::perception {
 
@@ -36,11 +37,8 @@ struct ConeCandidate {
   int points = 0;                                    // in the (reconstructed) cluster
 };
 
-// one box of the camera detector, in pixels (x right, y down, row 0 at the top)
-struct BoundingBox {
-  double x_min = 0.0, y_min = 0.0, x_max = 0.0, y_max = 0.0;  // px
-  ConeColor color = ConeColor::Unknown;                       // the detector's class
-  double confidence = 1.0;                                    // -, [0, 1]
-};
+// one box of the camera detector, in pixels (x right, y down, row 0 at the
+// top): the HAL's box, as a detector node posts it or ConeDetector returns it
+using BoundingBox = hal::CameraBox;
 
 }  // namespace paddock::perception

@@ -28,7 +28,7 @@ const char* to_string(PerceptionMode m) {
   return "ground_truth";
 }
 
-Stack::Stack(const StackParams& params, MissionSpec spec)
+Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<perception::ConeDetector> detector)
     : params_(params),
       spec_(std::move(spec)),
       controller_(params.control, params.vehicle),
@@ -37,7 +37,7 @@ Stack::Stack(const StackParams& params, MissionSpec spec)
   if (params_.modes.perception != PerceptionMode::GroundTruth) {
     perception::PerceptionParams pp = params_.perception;
     pp.use_camera = params_.modes.perception == PerceptionMode::LidarCamera;
-    perception_ = std::make_unique<perception::Perception>(pp, params_.seed);
+    perception_ = std::make_unique<perception::Perception>(pp, std::move(detector));
   }
   if (params_.modes.planner != PlannerMode::Oracle) return;
   // planner = oracle: the whole reference is planned once, before the start;
@@ -66,8 +66,10 @@ void Stack::on_message(hal::SensorMessage&& m) {
     // perception = ground_truth: the raw sensors' messages are not used
   } else if (const auto* scan = std::get_if<hal::LidarScan>(&m)) {
     on_detections(perception_->process(*scan));
-  } else if (auto* frame = std::get_if<hal::CameraFrame>(&m)) {
-    perception_->add(std::move(*frame));
+  } else if (auto* boxes = std::get_if<hal::CameraDetections>(&m)) {
+    perception_->add(std::move(*boxes));
+  } else if (const auto* frame = std::get_if<hal::CameraFrame>(&m)) {
+    perception_->add(*frame);
   } else if (const auto* imu = std::get_if<hal::Imu>(&m)) {
     perception_->add(*imu);
   } else if (const auto* wheels = std::get_if<hal::WheelSpeeds>(&m)) {

@@ -24,7 +24,7 @@ namespace paddock::stack {
 // where each layer's input comes from (the scenario's [autonomy] section)
 // perception: ground_truth = the simulator's object-level cone sensor posts
 // cone detections; lidar = the LiDAR pipeline on raw scans (intensity colour);
-// lidar_camera = the LiDAR pipeline fused with the camera detector
+// lidar_camera = the LiDAR pipeline fused with the camera detector's boxes
 enum class PerceptionMode { GroundTruth, Lidar, LidarCamera };
 enum class SlamMode { GroundTruth };
 enum class PlannerMode { Oracle, Delaunay };
@@ -76,7 +76,6 @@ struct StackParams {
   AutonomyModes modes;
   // perception = lidar | lidar_camera (use_camera follows the mode)
   perception::PerceptionParams perception;
-  std::uint64_t seed = 1;  // the stack's own random draws (the simulated detector's error model)
   planning::PathPlannerParams planner;   // its reference params serve the oracle mode too
   planning::SkidpadParams skidpad;
   control::ControlParams control;
@@ -118,7 +117,10 @@ struct Telemetry {
 
 class Stack {
  public:
-  Stack(const StackParams& params, MissionSpec spec);
+  // detector: perception = lidar_camera with the network in the stack, run on
+  // the camera frames; none when a detector node posts its boxes through the
+  // HAL (the simulator's does)
+  Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<perception::ConeDetector> detector = nullptr);
 
   // drains the HAL's messages, plans when there is news, runs one control
   // cycle, sends one command

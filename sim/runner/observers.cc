@@ -10,7 +10,10 @@
 namespace paddock::runner {
 namespace {
 
-PerceptionSnapshot take_snapshot(const perception::Perception& p, const Pose2& pose, const world::ConeWorld& cones) {
+// frame: the camera frame the runner rendered last (the one of the scan the
+// stack just processed), or null
+PerceptionSnapshot take_snapshot(const perception::Perception& p, const hal::CameraFrame* frame, const Pose2& pose,
+                                 const world::ConeWorld& cones) {
   const perception::PerceptionFrame& f = p.last();
   PerceptionSnapshot s;
   s.t = to_seconds(f.output.stamp);
@@ -23,13 +26,12 @@ PerceptionSnapshot take_snapshot(const perception::Perception& p, const Pose2& p
     const Vec2 local = pose.inverse_transform(cones.cone_position(i));
     if (norm(local) <= 40.0) s.truth.push_back({local, cones.cone(i).color});
   }
-  if (f.camera_used && p.camera_frame()) {
-    const hal::CameraFrame& frame = *p.camera_frame();
+  if (f.camera_used && frame != nullptr && frame->stamp == f.camera_stamp) {
     s.camera = true;
-    s.width = frame.width;
-    s.height = frame.height;
-    s.rgb = frame.rgb;
-    for (const perception::BoundingBox& b : f.detection.boxes) s.boxes.push_back({b.x_min, b.y_min, b.x_max, b.y_max, b.color});
+    s.width = frame->width;
+    s.height = frame->height;
+    s.rgb = frame->rgb;
+    for (const perception::BoundingBox& b : f.detections.boxes) s.boxes.push_back({b.x_min, b.y_min, b.x_max, b.y_max, b.color});
     for (const perception::FusedCone& c : f.fusion.cones) {
       if (!c.projected) continue;
       (c.source == perception::FusionSource::Dropped ? s.dropped : s.projected).push_back({c.pixel.x(), c.pixel.y()});
@@ -88,7 +90,8 @@ void SnapshotRecorder::observe(const SimModel& model, SimState& s) {
   frames_seen_ = frames;
   const double snapshot_time = model.scenario.sim.snapshot_time;
   if (armed_ && new_frame && s.t >= snapshot_time) {
-    snapshot_ = take_snapshot(*p, s.true_poses.at(s.stack.last_detections().stamp), s.cones);
+    snapshot_ = take_snapshot(*p, s.raw ? s.raw->camera_frame() : nullptr, s.true_poses.at(s.stack.last_detections().stamp),
+                              s.cones);
     p->set_keep_points(false);
   } else if (!armed_ && static_cast<double>(s.k + 1) * model.dt >= snapshot_time) {
     // perception keeps the points from the next step on

@@ -18,10 +18,12 @@ std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t 
 }
 
 RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
-                       const std::optional<sensors::CameraParams>& camera, std::uint64_t lidar_seed,
-                       std::uint64_t camera_seed)
+                       const std::optional<sensors::CameraParams>& camera, const sensors::DetectorParams& detector,
+                       std::uint64_t lidar_seed, std::uint64_t camera_seed, std::uint64_t detector_seed)
     : lidar_(lidar, lidar_seed), ground_(ground) {
-  if (camera) camera_ = std::make_unique<sensors::Camera>(*camera, camera_seed);
+  if (!camera) return;
+  camera_ = std::make_unique<sensors::Camera>(*camera, camera_seed);
+  detector_ = std::make_unique<sensors::AnnotationDetector>(detector, detector_seed);
 }
 
 TimeNs RawSensors::scan_end(TimeNs now) const {
@@ -77,7 +79,11 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
   const TimeNs start = now - lidar_.period_ns();
   if (camera_) {
     const TimeNs exposure = sensors::trigger_time(lidar_.params(), camera_->params().trigger_azimuth, start);
-    hal.post(camera_->render(*world_, poses.at(exposure), exposure));
+    camera_->render(*world_, poses.at(exposure), exposure, frame_, annotation_);
+    // the detector node's boxes on it, as the car's posts them (a frame it
+    // cannot read gives none, as a node that fails posts nothing)
+    sensors::AnnotationDetection d = detector_->detect(frame_, annotation_);
+    if (d.ok) hal.post(std::move(d.detections));
   }
   const std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [&poses](TimeNs t) { return poses.at(t); }, start);
   hal::LidarScan scan;

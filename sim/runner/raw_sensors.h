@@ -1,13 +1,18 @@
 #pragma once
 // the raw perception sensors of perception = lidar | lidar_camera in the
 // closed loop: the rotating LiDAR (and the camera it triggers) ray-cast the
-// cone world as it stands, from the car's pose at each column's own time.
+// cone world as it stands, from the car's pose at each column's own time;
+// and the camera's detector node, which turns each frame into the boxes a
+// network on the car would post.
 //
 // The loop records the base pose every physics step (PoseHistory); when a
 // rotation is over, the whole scan is cast from the recorded poses of that rotation (each column
 // from the pose at its own time, interpolated between physics steps), and
 // posted to the HAL as it would arrive from the driver: at the end of the
-// rotation. The Embree scene is rebuilt only when a cone moved or fell.
+// rotation. The camera frame's detections go first, as the detector node on
+// the car posts them (the frame itself stays here: nothing behind the HAL
+// looks at its pixels in the simulator). The Embree scene is rebuilt only when
+// a cone moved or fell.
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -17,6 +22,7 @@
 
 #include "autonomy/hal/messages.h"
 #include "sim/runner/sim_hal.h"
+#include "sim/sensors/annotation_detector.h"
 #include "sim/sensors/camera.h"
 #include "sim/sensors/lidar.h"
 #include "sim/world/cone_world.h"
@@ -41,29 +47,36 @@ std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t 
 
 class RawSensors {
  public:
-  // camera: the camera the LiDAR triggers (perception = lidar_camera), or none
-  // the LiDAR and the camera each draw from their own random stream
+  // camera: the camera the LiDAR triggers (perception = lidar_camera), or
+  // none; detector: the error model of its detector node. The LiDAR, the
+  // camera and the detector each draw from their own random stream
   RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
-             const std::optional<sensors::CameraParams>& camera, std::uint64_t lidar_seed, std::uint64_t camera_seed);
+             const std::optional<sensors::CameraParams>& camera, const sensors::DetectorParams& detector,
+             std::uint64_t lidar_seed, std::uint64_t camera_seed, std::uint64_t detector_seed);
 
   // true when a rotation ends at `now` (one starts at 0, then every period)
   bool rotation_ends(TimeNs now) const;
   // casts the rotation that ends at `now` against the cones as they stand,
   // each column from its pose in `poses` (which must cover the rotation), and
-  // posts the camera frame it triggered (exposed at the trigger column's time,
-  // from the pose of that instant), then the scan; returns its ground truth:
-  // per point the cone index hit (-1 the ground), in the order of the scan's points
+  // posts the detections of the camera frame it triggered (exposed at the
+  // trigger column's time, from the pose of that instant), then the scan;
+  // returns its ground truth: per point the cone index hit (-1 the ground), in
+  // the order of the scan's points
   const std::vector<std::int32_t>& emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,
                                         SimHal& hal);
   // the stamp of the scan's last column (the scan's `end`) for a rotation ending at `now`
   TimeNs scan_end(TimeNs now) const;
-
+  // the last camera frame rendered (for the perception figures), or null
+  const hal::CameraFrame* camera_frame() const { return camera_ && frame_.width > 0 ? &frame_ : nullptr; }
 
  private:
   void update_scene(const world::ConeWorld& cones);
 
   sensors::Lidar lidar_;
   std::unique_ptr<sensors::Camera> camera_;
+  std::unique_ptr<sensors::AnnotationDetector> detector_;
+  hal::CameraFrame frame_;
+  sensors::CameraAnnotation annotation_;
   sensors::GroundParams ground_;
   std::unique_ptr<sensors::LidarWorld> world_;
   std::vector<Cone> scene_cones_;

@@ -231,7 +231,7 @@ void add_lidar_fields(std::vector<Field>& f) {
   f.push_back(real_field("ground", "cell", "m", 0.01, 100.0, "height-field grid cell (a lower bound)", ACC(ground.cell)));
 }
 
-// [perception], [detector]: the stack's perception front
+// [perception]: the stack's perception front; [detector]: the camera's detector node
 void add_perception_fields(std::vector<Field>& f) {
   f.push_back(real_field("perception", "cluster_tolerance", "m", 0.01, 5.0, "Euclidean clustering: largest gap inside a cluster",
                          ACC(perception.lidar.clustering.tolerance)));
@@ -244,20 +244,20 @@ void add_perception_fields(std::vector<Field>& f) {
   f.push_back(real_field("perception", "camera_sync_tolerance", "s", 0.0, 1.0, "a camera frame serves the rotation it was exposed in, give or take this",
                          ACC(perception.camera_sync_tolerance)));
   f.push_back(real_field("detector", "p_miss_near", "", 0.0, 1.0, "chance of missing an unoccluded cone up to range_full",
-                         ACC(perception.detector.p_miss_near)));
-  f.push_back(real_field("detector", "range_full", "m", 0.0, 1000.0, "misses start to grow beyond this", ACC(perception.detector.range_full)));
-  f.push_back(real_field("detector", "range_max", "m", 0.0, 1000.0, "every cone is missed beyond this", ACC(perception.detector.range_max)));
+                         ACC(detector.p_miss_near)));
+  f.push_back(real_field("detector", "range_full", "m", 0.0, 1000.0, "misses start to grow beyond this", ACC(detector.range_full)));
+  f.push_back(real_field("detector", "range_max", "m", 0.0, 1000.0, "every cone is missed beyond this", ACC(detector.range_max)));
   f.push_back(real_field("detector", "visible_min", "", 0.0, 1.0, "a cone less visible than this is always missed",
-                         ACC(perception.detector.visible_min)));
+                         ACC(detector.visible_min)));
   f.push_back(real_field("detector", "visible_full", "", 0.0, 1.0, "occlusion adds no misses above this visible share",
-                         ACC(perception.detector.visible_full)));
+                         ACC(detector.visible_full)));
   f.push_back(real_field("detector", "p_confuse_blue_yellow", "", 0.0, 1.0, "chance of calling blue yellow or yellow blue",
-                         ACC(perception.detector.p_confuse_blue_yellow)));
+                         ACC(detector.p_confuse_blue_yellow)));
   f.push_back(real_field("detector", "p_confuse_orange_size", "", 0.0, 1.0, "chance of calling a small orange big or a big one small",
-                         ACC(perception.detector.p_confuse_orange_size)));
+                         ACC(detector.p_confuse_orange_size)));
   f.push_back(real_field("detector", "box_jitter", "", 0.0, 1.0, "std of each box edge as a share of the box size",
-                         ACC(perception.detector.box_jitter)));
-  f.push_back(real_field("detector", "min_box_height", "px", 0.0, 1000.0, "smaller boxes are never found", ACC(perception.detector.min_box_height)));
+                         ACC(detector.box_jitter)));
+  f.push_back(real_field("detector", "min_box_height", "px", 0.0, 1000.0, "smaller boxes are never found", ACC(detector.min_box_height)));
 }
 
 // [cones]: the Box2D cone world's physics
@@ -589,9 +589,8 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   if (const std::string why = params::validate(s.lidar); !why.empty()) throw UserError(path + ": [lidar] " + why);
   if (const std::string why = sensors::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
   if (const std::string why = sensors::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
+  if (const std::string why = sensors::validate(s.detector); !why.empty()) throw UserError(path + ": [detector] " + why);
   if (const std::string why = perception::validate(stack_params(s).perception); !why.empty()) {
-    // "detector.range_max ..." is a [detector] key; the rest are [perception]'s or derived
-    if (why.rfind("detector.", 0) == 0) throw UserError(path + ": [detector] " + why.substr(9));
     throw UserError(path + ": [perception] " + why);
   }
 
@@ -635,7 +634,7 @@ std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream) 
   };
   static constexpr Stream kStreams[] = {{"cone_sensor", 1, 0},     {"imu", 2, 0},   {"wheel_speeds", 3, 0},
                                         {"steering_sensor", 4, 0}, {"lidar", 5, 0}, {"camera", 5, 0xC0FFEEULL},
-                                        {"stack", 6, 0}};
+                                        {"detector", 6, 0}};
   for (const Stream& s : kStreams)
     if (s.name == stream) return (scenario_seed * 0x9E3779B97F4A7C15ULL + s.offset) ^ s.scramble;
   assert(false && "unknown random stream");
@@ -664,7 +663,6 @@ stack::StackParams stack_params(const Scenario& s) {
   k.rolling_resistance = v.cr0;
   // perception: the sensors' calibration is their true mounting and layout,
   // the odometry's wheel radius the car's
-  p.seed = stream_seed(s.scenario.seed, "stack");
   p.perception = s.perception;
   p.perception.odometry.wheel_radius = v.wheel_radius;
   p.perception.lidar.calibration = static_cast<const hal::LidarLayout&>(s.lidar);

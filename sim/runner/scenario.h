@@ -10,6 +10,7 @@
 
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
+#include "sim/sensors/annotation_detector.h"
 #include "sim/sensors/cone_sensor.h"
 #include "sim/sensors/camera.h"
 #include "sim/sensors/imu.h"
@@ -66,8 +67,9 @@ struct Scenario {
   sensors::SteeringSensorParams steering_sensor;  // [steering_sensor]
   sensors::LidarParams lidar;             // [lidar]: the rotating LiDAR of perception = lidar, lidar_camera
   sensors::CameraParams camera;           // [camera]: the camera of perception = lidar_camera
-  // [perception], [detector]: the stack's perception front (perception =
-  // lidar | lidar_camera); its calibration is filled from [lidar] and [camera]
+  sensors::DetectorParams detector;       // [detector]: the camera's detector node (its error model)
+  // [perception]: the stack's perception front (perception = lidar |
+  // lidar_camera); its calibration is filled from [lidar] and [camera]
   perception::PerceptionParams perception;
   sensors::GroundParams ground;           // [ground]: the ground's shape, as the sensors see it
   vehicle::VehicleParams vehicle;
@@ -98,7 +100,7 @@ world::TrackFile load_track_file(const std::string& path);
 // the seed of one named random stream of a run: every random draw of a run
 // comes from the scenario's seed through this function. The streams:
 // "cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera",
-// "stack"; any other name is a programming error. Their numbering is fixed:
+// "detector"; any other name is a programming error. Their numbering is fixed:
 // changing it changes every result.
 std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream);
 

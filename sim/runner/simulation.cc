@@ -100,8 +100,9 @@ void run_due(const SimModel& model, SimState& s) {
 std::unique_ptr<RawSensors> make_raw_sensors(const SimModel& model) {
   if (!model.raw_perception) return nullptr;
   const Scenario& sc = model.scenario;
-  return std::make_unique<RawSensors>(sc.lidar, sc.ground, model.camera, stream_seed(sc.scenario.seed, "lidar"),
-                                      stream_seed(sc.scenario.seed, "camera"));
+  const std::uint64_t seed = sc.scenario.seed;
+  return std::make_unique<RawSensors>(sc.lidar, sc.ground, model.camera, sc.detector, stream_seed(seed, "lidar"),
+                                      stream_seed(seed, "camera"), stream_seed(seed, "detector"));
 }
 
 // what the run leaves behind besides the observers' records: the event's

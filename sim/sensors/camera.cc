@@ -229,21 +229,22 @@ ConeColor Camera::cone_class(const LidarWorld& world, const ConeGeom& c, double 
   }
 }
 
-hal::CameraFrame Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp) {
-  hal::CameraFrame f;
-  render(world, base_pose, stamp, f);
+AnnotatedFrame Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp) {
+  AnnotatedFrame f;
+  render(world, base_pose, stamp, f.frame, f.annotation);
   return f;
 }
 
-void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp, hal::CameraFrame& out) {
+void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp, hal::CameraFrame& out,
+                    CameraAnnotation& annotation) {
   const int W = params_.width, H = params_.height;
   const std::size_t n_px = static_cast<std::size_t>(W) * static_cast<std::size_t>(H);
   out.stamp = stamp;
   out.width = W;
   out.height = H;
   out.rgb.resize(3 * n_px);
-  out.labels.assign(n_px, -1);
-  out.instances.clear();
+  annotation.labels.assign(n_px, -1);
+  annotation.instances.clear();
   last_primary_rays_ = last_continued_rays_ = 0;
   if (!finite(base_pose.x) || !finite(base_pose.y) || !finite(base_pose.yaw)) {
     std::fill(out.rgb.begin(), out.rgb.end(), std::uint8_t{0});
@@ -448,7 +449,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
     const std::array<std::uint8_t, 3> rgb = shade(albedo(params_, m), lambert_of(rh, k));
     std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
     if (cone >= 0) {
-      out.labels[p] = cone;
+      annotation.labels[p] = cone;
       ++visible_[static_cast<std::size_t>(cone)];
       ++unoccluded_[static_cast<std::size_t>(cone)];
       if (cover_[p] < 2) return;  // no other cone's box: nothing behind to count
@@ -469,7 +470,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
     ray_dir(p, d);
     std::int32_t seen[8];
     int n_seen = 0;
-    if (out.labels[p] >= 0) seen[n_seen++] = out.labels[p];
+    if (annotation.labels[p] >= 0) seen[n_seen++] = annotation.labels[p];
     float tnear = carry_t_[q];
     for (int it = 0; it < kMaxCarry; ++it) {
       RTCRayHit rh;
@@ -498,7 +499,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
     const ConeGeom& c = cones_[static_cast<std::size_t>(s)];
     const auto id = static_cast<std::size_t>(c.id);
     if (visible_[id] == 0) continue;
-    hal::CameraInstance inst;
+    CameraInstance inst;
     inst.id = c.id;
     double mid[3];
     inst.color = cone_class(world, c, mid);
@@ -506,7 +507,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
                            (mid[2] - o[2]) * (mid[2] - o[2]));
     inst.visible_fraction =
         std::min(1.0, static_cast<double>(visible_[id]) / static_cast<double>(std::max(unoccluded_[id], 1)));
-    out.instances.push_back(inst);
+    annotation.instances.push_back(inst);
   }
 
   // pixel noise: per channel a 12-bit uniform draw picks one of the 4096

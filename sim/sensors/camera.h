@@ -2,7 +2,11 @@
 // a global-shutter RGB camera on the main hoop, ray-cast with Embree 3 against
 // the LiDAR's scene (LidarWorld: the same cone meshes with their stripe
 // materials, the same ground), with the simulation's annotation: a per-pixel
-// label (the cone index) and one instance per visible cone.
+// label (the cone index) and one instance per visible cone. The frame is what
+// a camera driver gives (hal::CameraFrame); the annotation is the
+// simulation's alone (CameraAnnotation) and never crosses the HAL: the
+// annotation detector (annotation_detector.h) turns the two into the boxes a
+// detector node on the car would post.
 //
 // Model (CameraParams) + a small class holding its random stream and reusable
 // buffers (Camera). No I/O, no clock, no global state: render() is a pure
@@ -46,7 +50,7 @@
 // exact). That costs W H / 16 more rays on a large grid: about 5 ms a frame at
 // 800 x 500 (FSG 2023, 0.1 m bumps).
 //
-// Annotation. labels[p] = LidarWorld::cone_of of the first hit, -1 for ground
+// Annotation (CameraAnnotation). labels[p] = LidarWorld::cone_of of the first hit, -1 for ground
 // and sky. One CameraInstance per cone with >= 1 labelled pixel, in ascending
 // cone index: id = the cone index, color = its colour class (from the scene:
 // body material, big or small mesh), range = from the optical centre to the
@@ -132,6 +136,28 @@ struct CameraParams {
 // field name
 std::string validate(const CameraParams& p);
 
+// the simulation's annotation of one cone seen by the camera (a labelled data
+// set's box label); a hardware camera gives none
+struct CameraInstance {
+  std::int32_t id = -1;                  // the value of its pixels in CameraAnnotation::labels
+  ConeColor color = ConeColor::Unknown;  // its class
+  double range = 0.0;                    // m, from the camera's optical centre to the cone
+  double visible_fraction = 1.0;         // -, visible pixels / pixels it would cover unoccluded
+};
+
+// the simulation's annotation of one frame: per pixel (row-major, as the
+// frame's rgb) the id of the cone instance it shows, -1 for none; and the instances
+struct CameraAnnotation {
+  std::vector<std::int32_t> labels;
+  std::vector<CameraInstance> instances;
+};
+
+// one rendered frame: what the camera gives, and what only the simulation knows of it
+struct AnnotatedFrame {
+  hal::CameraFrame frame;
+  CameraAnnotation annotation;
+};
+
 // the LiDAR column nearest to azimuth (rad, lidar frame): column c looks at
 // -pi + 2 pi c / columns (lidar.h), so c = round((azimuth + pi) columns / 2 pi)
 // mod columns
@@ -153,11 +179,13 @@ class Camera {
   Camera(const CameraParams& params, std::uint64_t seed);
 
   // one frame of the scene seen from base_pose (the base frame in the map
-  // frame at the exposure), stamped `stamp`. A non-finite pose gives a black
-  // frame with no labelled pixel and no instance.
-  hal::CameraFrame render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp);
-  // the same into `out`, reusing its buffers (no allocation once sized)
-  void render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp, hal::CameraFrame& out);
+  // frame at the exposure), stamped `stamp`, and its annotation. A non-finite
+  // pose gives a black frame with no labelled pixel and no instance.
+  AnnotatedFrame render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp);
+  // the same into `out` and `annotation`, reusing their buffers (no
+  // allocation once sized)
+  void render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp, hal::CameraFrame& out,
+              CameraAnnotation& annotation);
 
   const CameraParams& params() const { return params_; }
   // K and T_camera_base, exactly those render() uses

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "autonomy/perception/camera_model.h"
-#include "autonomy/perception/detector.h"
+#include "sim/sensors/annotation_detector.h"
 #include "sim/sensors/camera.h"
 
 namespace paddock::perception {
@@ -152,15 +152,15 @@ TEST(Fusion, OnARenderedFrameWithTheCamerasCalibration) {
                                    {{12.0, 2.5}, ConeColor::BigOrange}, {{1.0, 3.0}, ConeColor::Yellow}};
   sensors::LidarWorld world(cones);
   sensors::Camera camera(sensors::CameraParams{}, 1);
-  const hal::CameraFrame frame = camera.render(world, Pose2{}, 0);
-  DetectorParams perfect;
+  const sensors::AnnotatedFrame shot = camera.render(world, Pose2{}, 0);
+  sensors::DetectorParams perfect;
   perfect.p_miss_near = 0.0;
   perfect.p_confuse_blue_yellow = 0.0;
   perfect.p_confuse_orange_size = 0.0;
   perfect.box_jitter = 0.0;
-  const DetectorResult det = AnnotationDetector(perfect, 1).detect(frame);
+  const sensors::AnnotationDetection det = sensors::AnnotationDetector(perfect, 1).detect(shot.frame, shot.annotation);
   ASSERT_TRUE(det.ok);
-  ASSERT_EQ(det.boxes.size(), 5u);  // the one beside the car is out of view
+  ASSERT_EQ(det.detections.boxes.size(), 5u);  // the one beside the car is out of view
 
   // candidates: cluster centres at 40 % of a cone's height (a cluster's centroid
   // sits a little below mid-height), a few cm off the axis
@@ -172,7 +172,7 @@ TEST(Fusion, OnARenderedFrameWithTheCamerasCalibration) {
   cands.push_back(cand(1.0, 3.0, 0.13, ConeColor::Yellow));  // beside the car: outside the FoV
   cands.push_back(cand(7.0, 0.0, 0.13));                     // in view, no cone there: fake
   cands.push_back(cand(7.0, -7.5, 0.13));                    // off the right edge: u = 400 + 400 7.5 / 6.05 = 896
-  const FusionResult r = fuse(cands, det.boxes, camera.calibration());
+  const FusionResult r = fuse(cands, det.detections.boxes, camera.calibration());
   ASSERT_EQ(r.cones.size(), 8u);
   for (std::size_t i = 0; i < 5; ++i) {
     EXPECT_EQ(r.cones[i].source, FusionSource::Camera) << i;

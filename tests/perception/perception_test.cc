@@ -1,8 +1,9 @@
 // the perception front as a whole (Perception: odometry + LiDAR pipeline +
-// annotation detector + fusion) on the simulator's ray-cast scans and rendered
-// frames, cast as sim/runner/raw_sensors.cc casts them (the scan with a pose
-// per column, the camera at the LiDAR's trigger time of that rotation) and
-// with the calibration sim/runner/scenario.cc's stack_params gives the stack.
+// fusion with the camera detector's boxes) on the simulator's ray-cast scans
+// and rendered frames, cast as sim/runner/raw_sensors.cc casts them (the scan
+// with a pose per column, the camera at the LiDAR's trigger time of that
+// rotation, its boxes from the simulator's detector node) and with the
+// calibration sim/runner/scenario.cc's stack_params gives the stack.
 // Checked against the simulator's ground truth: the cones' true positions
 // (moved into the base frame at the scan's end) and true colours.
 #include "autonomy/perception/perception.h"
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "autonomy/perception/camera_model.h"
+#include "sim/sensors/annotation_detector.h"
 #include "sim/sensors/camera.h"
 #include "sim/sensors/lidar.h"
 
@@ -55,6 +57,8 @@ constexpr double kTrack = 1.2;  // m, rear track: the rear wheels at y = +-0.6
 struct Inputs {
   hal::LidarScan scan;
   hal::CameraFrame frame;  // rendered at the trigger time of the rotation
+  sensors::CameraAnnotation annotation;  // the frame's, which only the simulation knows
+  hal::CameraDetections detections;      // the detector node's boxes on the frame
   std::vector<hal::Imu> imu;
   std::vector<hal::WheelSpeeds> wheels;
   std::vector<Cone> cones;       // world frame
@@ -67,11 +71,27 @@ const sensors::LidarParams kLidar{};
 const sensors::CameraParams kCamera{};
 const TimeNs kStart = from_seconds(1.0);
 
+// the detector node's error model in these tests: error-free but for its box
+// jitter (no misses, no class confusion). These tests check Perception's
+// plumbing, not the detector's error model (sim/sensors'
+// annotation_detector_test.cc does that), so a dropped or mis-coloured cone
+// here is Perception's doing.
+sensors::DetectorParams detector_params() {
+  sensors::DetectorParams p;
+  p.p_miss_near = 0.0;
+  p.range_full = 29.0;
+  p.range_max = 30.0;
+  p.p_confuse_blue_yellow = 0.0;
+  p.p_confuse_orange_size = 0.0;
+  return p;
+}
+
 // one rotation starting at `start` seen from a car moving as `m`; the
 // odometry's messages (every 5 ms, IMU and wheel speeds) are exact for that
-// motion and cover [start - 0.1 s, end + 10 ms]
+// motion and cover [start - 0.1 s, end + 10 ms]; the frame's detections from
+// a detector node (detector_params()) whose stream starts at detector_seed
 Inputs make_inputs(const std::vector<Cone>& cones, const Motion& m, TimeNs start, std::uint64_t seed,
-                   double wheel_radius = OdometryParams{}.wheel_radius) {
+                   std::uint64_t detector_seed = 7, double wheel_radius = OdometryParams{}.wheel_radius) {
   Inputs in;
   in.cones = cones;
   {
@@ -79,7 +99,11 @@ Inputs make_inputs(const std::vector<Cone>& cones, const Motion& m, TimeNs start
     sensors::Lidar lidar(kLidar, seed);
     sensors::Camera camera(kCamera, seed ^ 0xC0FFEEULL);
     const TimeNs exposure = sensors::trigger_time(kLidar, kCamera.trigger_azimuth, start);
-    in.frame = camera.render(world, m.at(exposure), exposure);
+    camera.render(world, m.at(exposure), exposure, in.frame, in.annotation);
+    sensors::AnnotationDetection d =
+        sensors::AnnotationDetector(detector_params(), detector_seed).detect(in.frame, in.annotation);
+    EXPECT_TRUE(d.ok) << d.reason;
+    in.detections = std::move(d.detections);
     const std::vector<sensors::LidarPoint> raw = lidar.scan(world, [&m](TimeNs t) { return m.at(t); }, start);
     in.scan.stamp = start;
     in.scan.end = lidar.column_time(start, kLidar.columns - 1);
@@ -107,11 +131,7 @@ void feed_odometry(Perception& p, const Inputs& in) {
   }
 }
 
-// the stack's parameters as stack_params fills them: the sensors' own
-// calibration. The detector is made error-free but for its box jitter (no
-// misses, no class confusion): these tests check Perception's plumbing, not
-// the detector's error model (detector_test.cc does that), so a dropped or
-// mis-coloured cone here is Perception's doing.
+// the stack's parameters as stack_params fills them: the sensors' own calibration
 PerceptionParams params(bool use_camera = true) {
   PerceptionParams p;
   p.use_camera = use_camera;
@@ -125,11 +145,6 @@ PerceptionParams params(bool use_camera = true) {
   lc.elevation_max = kLidar.elevation_max;
   lc.columns = kLidar.columns;
   p.camera = sensors::camera_calibration(kCamera);
-  p.detector.p_miss_near = 0.0;
-  p.detector.range_full = 29.0;
-  p.detector.range_max = 30.0;
-  p.detector.p_confuse_blue_yellow = 0.0;
-  p.detector.p_confuse_orange_size = 0.0;
   return p;
 }
 
@@ -264,9 +279,9 @@ TEST(Perception, LidarCameraAtRestOnAStraightTrack) {
   const Inputs in = make_inputs(straight_track(), Motion{0.0, 0.0, kStart}, kStart, 3);
   const PerceptionParams pp = params();
   ASSERT_EQ(validate(pp), "");
-  Perception per(pp, 7);
+  Perception per(pp);
   feed_odometry(per, in);
-  per.add(in.frame);
+  per.add(in.detections);
   const hal::ConeDetections& out = per.process(in.scan);
   EXPECT_EQ(out.stamp, in.scan.end);
   EXPECT_TRUE(per.last().lidar.ok) << per.last().lidar.status;
@@ -274,7 +289,8 @@ TEST(Perception, LidarCameraAtRestOnAStraightTrack) {
   EXPECT_TRUE(per.last().camera_used) << per.last().camera_note;
   EXPECT_EQ(per.last().camera_note, "");
   EXPECT_EQ(per.last().camera_stamp, in.frame.stamp);
-  EXPECT_TRUE(per.last().detection.ok) << per.last().detection.reason;
+  EXPECT_EQ(per.last().detections.boxes.size(), in.detections.boxes.size());
+  EXPECT_FALSE(in.detections.boxes.empty());
   EXPECT_EQ(per.last().fusion.cones.size(), per.last().lidar.cones.size());
   EXPECT_EQ(per.stats().scans, 1);
   EXPECT_EQ(per.stats().scans_without_camera, 0);
@@ -302,9 +318,9 @@ TEST(Perception, LidarCameraAtRestOnAStraightTrack) {
   // parabola: all Unknown): the true colours in view can only be the camera's
   PerceptionParams blind = pp;
   blind.lidar.colour.min_layers = 1000;
-  Perception per_b(blind, 7);
+  Perception per_b(blind);
   feed_odometry(per_b, in);
-  per_b.add(in.frame);
+  per_b.add(in.detections);
   per_b.process(in.scan);
   ASSERT_TRUE(per_b.last().camera_used);
   for (const ConeCandidate& c : per_b.last().lidar.cones) EXPECT_EQ(c.color, ConeColor::Unknown);
@@ -319,13 +335,14 @@ TEST(Perception, LidarCameraAtRestOnAStraightTrack) {
 TEST(Perception, LidarOnlyUsesTheIntensityColour) {
   const Inputs in = make_inputs(straight_track(), Motion{0.0, 0.0, kStart}, kStart, 3);
   const PerceptionParams pp = params(false);
-  Perception per(pp, 7);
+  Perception per(pp);
   feed_odometry(per, in);
-  per.add(in.frame);  // ignored in this mode
+  per.add(in.detections);  // ignored in this mode
+  per.add(in.frame);
   const hal::ConeDetections& out = per.process(in.scan);
   EXPECT_FALSE(per.last().camera_used);
   EXPECT_EQ(per.last().camera_note, "");
-  EXPECT_FALSE(per.last().detection.ok);
+  EXPECT_TRUE(per.last().detections.boxes.empty());
   EXPECT_TRUE(per.last().fusion.cones.empty());
   EXPECT_EQ(per.stats().scans_without_camera, 0);  // the mode has no camera: nothing fell back
 
@@ -357,7 +374,7 @@ TEST(Perception, LidarOnlyUsesTheIntensityColour) {
 
 // the LiDAR-only output of the same scan, for comparison
 hal::ConeDetections lidar_only(const Inputs& in) {
-  Perception per(params(false), 7);
+  Perception per(params(false));
   feed_odometry(per, in);
   return per.process(in.scan);
 }
@@ -372,47 +389,48 @@ void expect_same(const hal::ConeDetections& a, const hal::ConeDetections& b) {
   }
 }
 
-TEST(Perception, WithoutACameraFrameOfTheRotationFallsBackToLidar) {
+TEST(Perception, WithoutDetectionsOfTheRotationFallsBackToLidar) {
   const Inputs in = make_inputs(straight_track(), Motion{0.0, 0.0, kStart}, kStart, 3);
   const hal::ConeDetections reference = lidar_only(in);
   ASSERT_GT(reference.cones.size(), 10u);
   const PerceptionParams pp = params();
   const TimeNs tol = from_seconds(pp.camera_sync_tolerance);
 
-  // no frame at all
-  Perception per(pp, 7);
+  // no detections at all; a frame alone is not looked at without a detector of its own
+  Perception per(pp);
   feed_odometry(per, in);
+  per.add(in.frame);
   expect_same(per.process(in.scan), reference);
   EXPECT_FALSE(per.last().camera_used);
-  EXPECT_EQ(per.last().camera_note, "no camera frame");
+  EXPECT_EQ(per.last().camera_note, "no camera detections");
   EXPECT_EQ(per.stats().scans, 1);
   EXPECT_EQ(per.stats().scans_without_camera, 1);
 
-  // frames stamped just outside the rotation plus the tolerance, either side
+  // detections stamped just outside the rotation plus the tolerance, either side
   for (const TimeNs stamp : {in.scan.stamp - tol - 1, in.scan.end + tol + 1}) {
-    hal::CameraFrame f = in.frame;
-    f.stamp = stamp;
-    per.add(f);
+    hal::CameraDetections d = in.detections;
+    d.stamp = stamp;
+    per.add(d);
     expect_same(per.process(in.scan), reference);
     EXPECT_FALSE(per.last().camera_used);
-    EXPECT_EQ(per.last().camera_note, "no camera frame of this rotation");
+    EXPECT_EQ(per.last().camera_note, "no camera detections of this rotation");
   }
   EXPECT_EQ(per.stats().scans, 3);
   EXPECT_EQ(per.stats().scans_without_camera, 3);
 
-  // ... and just inside: used (the frame's content is the trigger time's; at
-  // rest the stamp does not matter)
+  // ... and just inside: used (the boxes are the trigger time's; at rest the
+  // stamp does not matter)
   for (const TimeNs stamp : {in.scan.stamp - tol, in.scan.end + tol}) {
-    hal::CameraFrame f = in.frame;
-    f.stamp = stamp;
-    per.add(f);
+    hal::CameraDetections d = in.detections;
+    d.stamp = stamp;
+    per.add(d);
     per.process(in.scan);
     EXPECT_TRUE(per.last().camera_used) << per.last().camera_note;
     EXPECT_EQ(per.last().camera_stamp, stamp);
   }
   EXPECT_EQ(per.stats().scans, 5);
   EXPECT_EQ(per.stats().scans_without_camera, 3);
-  // the next rotation: the kept frame is the previous rotation's (its
+  // the next rotation: the kept detections are the previous rotation's (its
   // trigger 0.1 s before this one's), not used again, and no stale
   // exposure time of it is left in last()
   hal::LidarScan next = in.scan;
@@ -420,33 +438,85 @@ TEST(Perception, WithoutACameraFrameOfTheRotationFallsBackToLidar) {
   next.stamp += period;
   next.end += period;
   for (hal::LidarPoint& q : next.points) q.t += period;
-  hal::CameraFrame previous = in.frame;
-  per.add(previous);
+  per.add(in.detections);
   per.process(next);
   EXPECT_FALSE(per.last().camera_used);
-  EXPECT_EQ(per.last().camera_note, "no camera frame of this rotation");
+  EXPECT_EQ(per.last().camera_note, "no camera detections of this rotation");
   EXPECT_EQ(per.last().camera_stamp, 0);
-  EXPECT_FALSE(per.last().detection.ok);
+  EXPECT_TRUE(per.last().detections.boxes.empty());
   EXPECT_TRUE(per.last().fusion.cones.empty());
   EXPECT_EQ(per.stats().scans_without_camera, 4);
+
+  // detections on an image of another size than the calibration's are not fused
+  hal::CameraDetections resized = in.detections;
+  resized.width /= 2;
+  per.add(resized);
+  expect_same(per.process(in.scan), reference);
+  EXPECT_FALSE(per.last().camera_used);
+  EXPECT_NE(per.last().camera_note.find("400 x 500 image"), std::string::npos) << per.last().camera_note;
+  EXPECT_EQ(per.stats().scans_without_camera, 5);
 }
 
-TEST(Perception, AHardwareFrameIsRefusedByTheAnnotationDetector) {
+// a network on the car as Perception runs it (ConeDetector): here the
+// simulator's boxes of the one frame it knows, found by that frame's stamp
+class KnownFrameDetector : public ConeDetector {
+ public:
+  explicit KnownFrameDetector(const Inputs& in) : in_(in) {}
+  DetectorResult detect(const hal::CameraFrame& frame) override {
+    ++calls;
+    DetectorResult r;
+    if (frame.stamp != in_.frame.stamp) {
+      r.reason = "an unknown frame";
+      return r;
+    }
+    r.ok = true;
+    r.boxes = in_.detections.boxes;
+    return r;
+  }
+  int calls = 0;
+
+ private:
+  const Inputs& in_;
+};
+
+TEST(Perception, ADetectorOfItsOwnRunsOnTheFramesAsANodeWouldPostItsBoxes) {
   const Inputs in = make_inputs(straight_track(), Motion{0.0, 0.0, kStart}, kStart, 3);
-  Perception per(params(), 7);
+  // the boxes as a detector node posts them
+  Perception posted(params());
+  feed_odometry(posted, in);
+  posted.add(in.detections);
+  posted.process(in.scan);
+  ASSERT_TRUE(posted.last().camera_used) << posted.last().camera_note;
+
+  // the same boxes from a network Perception runs on the frame itself
+  auto owned = std::make_unique<KnownFrameDetector>(in);
+  KnownFrameDetector* net = owned.get();
+  Perception per(params(), std::move(owned));
   feed_odometry(per, in);
-  hal::CameraFrame hw;  // what a real camera gives: pixels, no annotation
-  hw.stamp = in.frame.stamp;
-  hw.width = in.frame.width;
-  hw.height = in.frame.height;
-  hw.rgb = in.frame.rgb;
-  ASSERT_FALSE(hw.rgb.empty());
-  per.add(hw);
+  per.add(in.frame);
+  EXPECT_EQ(net->calls, 1);
+  expect_same(per.process(in.scan), posted.last().output);
+  EXPECT_TRUE(per.last().camera_used) << per.last().camera_note;
+  EXPECT_EQ(per.last().camera_stamp, in.frame.stamp);
+  EXPECT_EQ(per.last().detections.width, in.frame.width);
+  EXPECT_EQ(per.last().detections.boxes.size(), in.detections.boxes.size());
+
+  // a frame the network cannot read: LiDAR only for the scan of its rotation, with the reason
+  hal::CameraFrame other = in.frame;
+  other.stamp += 1;
+  per.add(other);
+  EXPECT_EQ(net->calls, 2);
   expect_same(per.process(in.scan), lidar_only(in));
   EXPECT_FALSE(per.last().camera_used);
-  EXPECT_FALSE(per.last().detection.ok);
-  EXPECT_EQ(per.last().camera_note.rfind("detector:", 0), 0u) << per.last().camera_note;
+  EXPECT_EQ(per.last().camera_note, "detector: an unknown frame");
   EXPECT_EQ(per.stats().scans_without_camera, 1);
+
+  // the LiDAR-only mode does not run it
+  Perception lidar(params(false), std::make_unique<KnownFrameDetector>(in));
+  feed_odometry(lidar, in);
+  lidar.add(in.frame);
+  expect_same(lidar.process(in.scan), lidar_only(in));
+  EXPECT_EQ(lidar.last().camera_note, "");
 }
 
 // ------------------------------------------------------------- moving
@@ -460,12 +530,12 @@ struct MovingCase {
 };
 
 void moving(const MovingCase& mc) {
-  const Inputs in = make_inputs(straight_track(), Motion{mc.v, mc.w, kStart}, kStart, 5);
+  const Inputs in = make_inputs(straight_track(), Motion{mc.v, mc.w, kStart}, kStart, 5, 11);
   ASSERT_EQ(in.frame.stamp - in.scan.stamp, from_seconds(0.05));
   const PerceptionParams pp = params();
-  Perception per(pp, 11);
+  Perception per(pp);
   feed_odometry(per, in);
-  per.add(in.frame);
+  per.add(in.detections);
   per.process(in.scan);
   EXPECT_TRUE(per.last().lidar.corrected);
   ASSERT_TRUE(per.last().camera_used) << per.last().camera_note;
@@ -483,7 +553,7 @@ void moving(const MovingCase& mc) {
 
   // the counterfactual: the same candidates and boxes fused without the move
   // from the scan's end to the exposure
-  const FusionResult unmoved = fuse(per.last().lidar.cones, per.last().detection.boxes, pp.camera, pp.fusion);
+  const FusionResult unmoved = fuse(per.last().lidar.cones, per.last().detections.boxes, pp.camera, pp.fusion);
   const FusionResult& moved = per.last().fusion;
   std::printf("%s: fused with the odometry's move %d from the camera, %d dropped; unmoved %d, %d dropped\n",
               mc.name, moved.from_camera, moved.dropped, unmoved.from_camera, unmoved.dropped);
@@ -499,8 +569,8 @@ void moving(const MovingCase& mc) {
   // the odometry (measured below), so that is not asserted. But the output,
   // stamped at the scan's end, is off by the car's motion over the last
   // 50 ms: the positions fail.
-  Perception blind(pp, 11);
-  blind.add(in.frame);
+  Perception blind(pp);
+  blind.add(in.detections);
   blind.process(in.scan);
   EXPECT_FALSE(blind.last().lidar.corrected);
   EXPECT_EQ(blind.stats().scans_uncorrected, 1);
@@ -532,9 +602,9 @@ TEST(Perception, TurningAt8MetresASecondAndHalfARadianASecond) { moving({"turnin
 
 TEST(Perception, EmptyAndNanScansGiveNoConesAndAreCounted) {
   const Inputs in = make_inputs(straight_track(), Motion{0.0, 0.0, kStart}, kStart, 3);
-  Perception per(params(), 7);
+  Perception per(params());
   feed_odometry(per, in);
-  per.add(in.frame);
+  per.add(in.detections);
 
   hal::LidarScan empty;
   empty.stamp = in.scan.stamp;
@@ -564,27 +634,29 @@ TEST(Perception, EmptyAndNanScansGiveNoConesAndAreCounted) {
 
 // ------------------------------------------------------------- determinism
 
-TEST(Perception, SameInputsAndSeedGiveIdenticalOutput) {
-  // three rotations of the turning car, the detector's default error model
-  // (misses, confusion, jitter) so that its random stream matters
-  PerceptionParams pp = params();
-  pp.detector = DetectorParams{};
-  Perception a(pp, 42), b(pp, 42);
+TEST(Perception, SameInputsGiveIdenticalOutput) {
+  // three rotations of the turning car, their boxes from one detector node
+  // with the default error model (misses, confusion, jitter)
+  const PerceptionParams pp = params();
+  Perception a(pp), b(pp);
+  sensors::AnnotationDetector node(sensors::DetectorParams{}, 42);
   const Motion m{8.0, 0.5, kStart};
   const TimeNs period = from_seconds(1.0 / kLidar.rate);
   for (int k = 0; k < 3; ++k) {
     const Inputs in = make_inputs(straight_track(), m, kStart + k * period, 20 + static_cast<std::uint64_t>(k));
+    const sensors::AnnotationDetection d = node.detect(in.frame, in.annotation);
+    ASSERT_TRUE(d.ok) << d.reason;
     for (Perception* p : {&a, &b}) {
       feed_odometry(*p, in);
-      p->add(in.frame);
+      p->add(d.detections);
       p->process(in.scan);
     }
     ASSERT_TRUE(a.last().camera_used);
     expect_same(a.last().output, b.last().output);
-    ASSERT_EQ(a.last().detection.boxes.size(), b.last().detection.boxes.size());
-    for (std::size_t i = 0; i < a.last().detection.boxes.size(); ++i) {
-      EXPECT_EQ(a.last().detection.boxes[i].x_min, b.last().detection.boxes[i].x_min);
-      EXPECT_EQ(a.last().detection.boxes[i].color, b.last().detection.boxes[i].color);
+    ASSERT_EQ(a.last().detections.boxes.size(), b.last().detections.boxes.size());
+    for (std::size_t i = 0; i < a.last().detections.boxes.size(); ++i) {
+      EXPECT_EQ(a.last().detections.boxes[i].x_min, b.last().detections.boxes[i].x_min);
+      EXPECT_EQ(a.last().detections.boxes[i].color, b.last().detections.boxes[i].color);
     }
     EXPECT_FALSE(a.last().output.cones.empty());
   }
@@ -600,10 +672,10 @@ TEST(Perception, ValidateRejectsABadCameraOnlyWhenTheModeUsesIt) {
   const std::string why = validate(p);
   EXPECT_EQ(why.rfind("camera", 0), 0u) << why;
   EXPECT_NE(why.find("fx"), std::string::npos) << why;
-  EXPECT_THROW(Perception(p, 1), std::invalid_argument);
+  EXPECT_THROW(Perception{p}, std::invalid_argument);
   p.use_camera = false;
   EXPECT_EQ(validate(p), "");
-  EXPECT_NO_THROW(Perception(p, 1));
+  EXPECT_NO_THROW(Perception{p});
   // the default calibration (all zero) is no camera either
   PerceptionParams d = params();
   d.camera = CameraCalibration{};

@@ -118,6 +118,19 @@ TEST(Scenario, OverridesWinAndAreChecked) {
   EXPECT_THAT(msg({"scenario.seed=1", "control.nokey=1"}), HasSubstr("--set:2: unknown key 'nokey' in [control]"));
 }
 
+TEST(Scenario, DetectorKeysSetTheSimulatedDetectorNode) {
+  // [detector] is the simulator's detector node (sim/sensors), not the stack's
+  const Scenario s = load_scenario(kDefault, {"detector.p_miss_near=0.1", "detector.box_jitter=0.05"});
+  EXPECT_EQ(s.detector.p_miss_near, 0.1);
+  EXPECT_EQ(s.detector.box_jitter, 0.05);
+  try {
+    load_scenario(kDefault, {"detector.range_full=40"});  // beyond range_max
+    ADD_FAILURE() << "no error";
+  } catch (const UserError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("[detector] range_max must be finite and > range_full"));
+  }
+}
+
 TEST(Scenario, ResolvedFileReadsBackToTheSameScenario) {
   const Scenario a = load_scenario(kDefault, {"control.stanley_k=3.25", "vehicle.steering_max=25 deg"});
   const std::string text = resolved_ini(a);

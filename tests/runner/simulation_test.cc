@@ -140,7 +140,7 @@ TEST(Simulation, TwoModelsWithOtherSeedsOnTwoThreadsStayApart) {
 }
 
 TEST(Simulation, StreamSeedsDifferPerStream) {
-  const char* streams[] = {"cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera", "stack"};
+  const char* streams[] = {"cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera", "detector"};
   for (const char* a : streams) {
     for (const char* b : streams) {
       if (std::strcmp(a, b) != 0) {

@@ -29,20 +29,20 @@ struct Blob {
   long r = 0, g = 0, b = 0;  // summed colour
 };
 
-Blob blob(const hal::CameraFrame& f, std::int32_t id) {
+Blob blob(const AnnotatedFrame& f, std::int32_t id) {
   Blob bl;
-  for (int j = 0; j < f.height; ++j) {
-    for (int i = 0; i < f.width; ++i) {
-      const std::size_t p = static_cast<std::size_t>(j) * f.width + i;
-      if (f.labels[p] != id) continue;
+  for (int j = 0; j < f.frame.height; ++j) {
+    for (int i = 0; i < f.frame.width; ++i) {
+      const std::size_t p = static_cast<std::size_t>(j) * f.frame.width + i;
+      if (f.annotation.labels[p] != id) continue;
       ++bl.count;
       bl.i0 = std::min(bl.i0, i);
       bl.i1 = std::max(bl.i1, i);
       bl.j0 = std::min(bl.j0, j);
       bl.j1 = std::max(bl.j1, j);
-      bl.r += f.rgb[3 * p];
-      bl.g += f.rgb[3 * p + 1];
-      bl.b += f.rgb[3 * p + 2];
+      bl.r += f.frame.rgb[3 * p];
+      bl.g += f.frame.rgb[3 * p + 1];
+      bl.b += f.frame.rgb[3 * p + 2];
     }
   }
   return bl;
@@ -115,17 +115,17 @@ TEST(Camera, SingleConeSitsWhereItsCentreProjects) {
     const double X = 7.0;
     LidarWorld world({Cone{{X, y}, color}});
     Camera cam(p, 1);
-    const hal::CameraFrame f = cam.render(world, Pose2{}, 123);
-    ASSERT_EQ(f.width * f.height, 800 * 500);
-    ASSERT_EQ(f.rgb.size(), 3u * 800 * 500);
-    ASSERT_EQ(f.labels.size(), 800u * 500);
-    EXPECT_EQ(f.stamp, 123);
-    ASSERT_EQ(f.instances.size(), 1u);
-    EXPECT_EQ(f.instances[0].id, 0);
-    EXPECT_EQ(f.instances[0].color, color);
-    EXPECT_NEAR(f.instances[0].visible_fraction, 1.0, 1e-12);
+    const AnnotatedFrame f = cam.render(world, Pose2{}, 123);
+    ASSERT_EQ(f.frame.width * f.frame.height, 800 * 500);
+    ASSERT_EQ(f.frame.rgb.size(), 3u * 800 * 500);
+    ASSERT_EQ(f.annotation.labels.size(), 800u * 500);
+    EXPECT_EQ(f.frame.stamp, 123);
+    ASSERT_EQ(f.annotation.instances.size(), 1u);
+    EXPECT_EQ(f.annotation.instances[0].id, 0);
+    EXPECT_EQ(f.annotation.instances[0].color, color);
+    EXPECT_NEAR(f.annotation.instances[0].visible_fraction, 1.0, 1e-12);
     // range to the middle of the axis, h / 2 = 0.1625 m up
-    EXPECT_NEAR(f.instances[0].range,
+    EXPECT_NEAR(f.annotation.instances[0].range,
                 std::sqrt((X - 0.95) * (X - 0.95) + y * y + (1.2 - 0.1625) * (1.2 - 0.1625)), 1e-4);
 
     const Blob b = blob(f, 0);
@@ -143,7 +143,7 @@ TEST(Camera, SingleConeSitsWhereItsCentreProjects) {
     EXPECT_LE(c.v, b.j1 + 1);
     // the pixel under it is the cone's
     const auto pi = static_cast<std::size_t>(c.u), pj = static_cast<std::size_t>(c.v);
-    EXPECT_EQ(f.labels[pj * 800 + pi], 0);
+    EXPECT_EQ(f.annotation.labels[pj * 800 + pi], 0);
     // its box: f h / r tall and f w / r wide, within a few px (the pitch and
     // the base's depth make the true figures differ a little)
     const double depth = c.depth;
@@ -158,7 +158,7 @@ TEST(Camera, SingleConeSitsWhereItsCentreProjects) {
       EXPECT_GT(b.g, 2 * b.b);
     }
     // nothing else is labelled
-    EXPECT_EQ(std::count(f.labels.begin(), f.labels.end(), -1), 800 * 500 - b.count);
+    EXPECT_EQ(std::count(f.annotation.labels.begin(), f.annotation.labels.end(), -1), 800 * 500 - b.count);
   }
 }
 
@@ -171,37 +171,37 @@ TEST(Camera, HiddenConeHasTheVisibleFractionOfItsUnoccludedPixels) {
   LidarWorld both({front, back});
   LidarWorld alone({back});
   Camera cam(p, 1);
-  const hal::CameraFrame f = cam.render(both, Pose2{}, 0);
+  const AnnotatedFrame f = cam.render(both, Pose2{}, 0);
   EXPECT_GT(cam.last_continued_rays(), 0u);  // the rays through the front cone
-  const hal::CameraFrame g = cam.render(alone, Pose2{}, 0);
-  ASSERT_EQ(f.instances.size(), 2u);
-  ASSERT_EQ(g.instances.size(), 1u);
-  EXPECT_EQ(f.instances[0].id, 0);
-  EXPECT_EQ(f.instances[1].id, 1);
-  EXPECT_NEAR(f.instances[0].visible_fraction, 1.0, 1e-12);
+  const AnnotatedFrame g = cam.render(alone, Pose2{}, 0);
+  ASSERT_EQ(f.annotation.instances.size(), 2u);
+  ASSERT_EQ(g.annotation.instances.size(), 1u);
+  EXPECT_EQ(f.annotation.instances[0].id, 0);
+  EXPECT_EQ(f.annotation.instances[1].id, 1);
+  EXPECT_NEAR(f.annotation.instances[0].visible_fraction, 1.0, 1e-12);
   const int seen = blob(f, 1).count, whole = blob(g, 0).count;
   ASSERT_GT(whole, 100);
   EXPECT_GT(seen, 0);
   EXPECT_LT(seen, whole);
-  EXPECT_NEAR(f.instances[1].visible_fraction, static_cast<double>(seen) / whole, 1e-9);
-  EXPECT_LT(f.instances[1].visible_fraction, 0.9);
-  std::printf("hidden cone: %d of %d pixels visible (%.3f)\n", seen, whole, f.instances[1].visible_fraction);
+  EXPECT_NEAR(f.annotation.instances[1].visible_fraction, static_cast<double>(seen) / whole, 1e-9);
+  EXPECT_LT(f.annotation.instances[1].visible_fraction, 0.9);
+  std::printf("hidden cone: %d of %d pixels visible (%.3f)\n", seen, whole, f.annotation.instances[1].visible_fraction);
 }
 
 TEST(Camera, NoConesGivesSkyAboveTheHorizonAndGroundBelow) {
   const CameraParams p;
   LidarWorld world({});
   Camera cam(p, 1);
-  const hal::CameraFrame f = cam.render(world, Pose2{3.0, -2.0, 0.7}, 0);
-  EXPECT_TRUE(f.instances.empty());
-  EXPECT_EQ(std::count(f.labels.begin(), f.labels.end(), -1), 800 * 500);
+  const AnnotatedFrame f = cam.render(world, Pose2{3.0, -2.0, 0.7}, 0);
+  EXPECT_TRUE(f.annotation.instances.empty());
+  EXPECT_EQ(std::count(f.annotation.labels.begin(), f.annotation.labels.end(), -1), 800 * 500);
   // horizon: v = cy - f tan(pitch) = 250 - 400 tan(5 deg) = 215.0; rows whose
   // centres (j + 0.5) lie above it are sky, below ground
   const double vh = 250.0 - 400.0 * std::tan(5.0 * kPi / 180.0);
   ASSERT_NEAR(vh, 215.0, 0.1);
   const auto px = [&](int i, int j) {
     const std::size_t q = 3 * (static_cast<std::size_t>(j) * 800 + i);
-    return std::array<int, 3>{f.rgb[q], f.rgb[q + 1], f.rgb[q + 2]};
+    return std::array<int, 3>{f.frame.rgb[q], f.frame.rgb[q + 1], f.frame.rgb[q + 2]};
   };
   // sky: the configured colour (0.55, 0.72, 0.92) * 255
   const std::array<int, 3> sky{140, 184, 235};
@@ -226,11 +226,11 @@ TEST(Camera, ColourClassesOfEveryConeKindStandingOrKnocked) {
   const std::vector<bool> knocked = {false, false, false, false, false, true, true};
   LidarWorld world(cones, knocked);
   Camera cam(CameraParams{}, 1);
-  const hal::CameraFrame f = cam.render(world, Pose2{}, 0);
-  ASSERT_EQ(f.instances.size(), cones.size());
+  const AnnotatedFrame f = cam.render(world, Pose2{}, 0);
+  ASSERT_EQ(f.annotation.instances.size(), cones.size());
   for (std::size_t k = 0; k < cones.size(); ++k) {
-    EXPECT_EQ(f.instances[k].id, static_cast<int>(k));
-    EXPECT_EQ(f.instances[k].color, cones[k].color) << k;
+    EXPECT_EQ(f.annotation.instances[k].id, static_cast<int>(k));
+    EXPECT_EQ(f.annotation.instances[k].color, cones[k].color) << k;
   }
   // a knocked big cone lies along x: wider than tall on the image? It lies
   // along the line of sight here, so only its height (its base width 0.285 m)
@@ -245,14 +245,14 @@ TEST(Camera, DeterministicWithNoiseAndNoiseHasTheConfiguredSpread) {
   for (int i = 0; i < 20; ++i) cones.push_back({{3.0 + i, (i % 2) ? 1.5 : -1.5}, (i % 2) ? ConeColor::Blue : ConeColor::Yellow});
   LidarWorld world(cones);
   Camera a(p, 42), b(p, 42);
-  const hal::CameraFrame fa = a.render(world, Pose2{0.5, 0.2, 0.1}, 7);
-  const hal::CameraFrame fb = b.render(world, Pose2{0.5, 0.2, 0.1}, 7);
-  EXPECT_EQ(fa.rgb, fb.rgb);
-  EXPECT_EQ(fa.labels, fb.labels);
-  ASSERT_EQ(fa.instances.size(), fb.instances.size());
-  for (std::size_t k = 0; k < fa.instances.size(); ++k) {
-    EXPECT_EQ(fa.instances[k].id, fb.instances[k].id);
-    EXPECT_EQ(fa.instances[k].visible_fraction, fb.instances[k].visible_fraction);
+  const AnnotatedFrame fa = a.render(world, Pose2{0.5, 0.2, 0.1}, 7);
+  const AnnotatedFrame fb = b.render(world, Pose2{0.5, 0.2, 0.1}, 7);
+  EXPECT_EQ(fa.frame.rgb, fb.frame.rgb);
+  EXPECT_EQ(fa.annotation.labels, fb.annotation.labels);
+  ASSERT_EQ(fa.annotation.instances.size(), fb.annotation.instances.size());
+  for (std::size_t k = 0; k < fa.annotation.instances.size(); ++k) {
+    EXPECT_EQ(fa.annotation.instances[k].id, fb.annotation.instances[k].id);
+    EXPECT_EQ(fa.annotation.instances[k].visible_fraction, fb.annotation.instances[k].visible_fraction);
   }
   // the sky's red channel (140) with noise: mean 140, std 4 (the table's rounding
   // to whole levels adds about 1/12 to the variance, its 3.4 sigma cut takes 1 %)
@@ -260,7 +260,7 @@ TEST(Camera, DeterministicWithNoiseAndNoiseHasTheConfiguredSpread) {
   int n = 0;
   for (int j = 0; j < 150; ++j) {
     for (int i = 0; i < 800; ++i) {
-      const double v = fa.rgb[3 * (static_cast<std::size_t>(j) * 800 + i)];
+      const double v = fa.frame.rgb[3 * (static_cast<std::size_t>(j) * 800 + i)];
       s += v;
       s2 += v * v;
       ++n;
@@ -270,9 +270,9 @@ TEST(Camera, DeterministicWithNoiseAndNoiseHasTheConfiguredSpread) {
   EXPECT_NEAR(mean, 140.0, 0.1);
   EXPECT_NEAR(sd, std::sqrt(16.0 + 1.0 / 12.0), 0.1);
   // the next frame's noise differs
-  const hal::CameraFrame fc = a.render(world, Pose2{0.5, 0.2, 0.1}, 7);
-  EXPECT_NE(fa.rgb, fc.rgb);
-  EXPECT_EQ(fa.labels, fc.labels);
+  const AnnotatedFrame fc = a.render(world, Pose2{0.5, 0.2, 0.1}, 7);
+  EXPECT_NE(fa.frame.rgb, fc.frame.rgb);
+  EXPECT_EQ(fa.annotation.labels, fc.annotation.labels);
 }
 
 TEST(Camera, ConeOnSlopedGroundIsSeenWhereItStands) {
@@ -281,9 +281,9 @@ TEST(Camera, ConeOnSlopedGroundIsSeenWhereItStands) {
   LidarWorld world({Cone{{8.0, 0.5}, ConeColor::Yellow}}, {}, g);
   CameraParams p;
   Camera cam(p, 1);
-  const hal::CameraFrame f = cam.render(world, Pose2{}, 0);
-  ASSERT_EQ(f.instances.size(), 1u);
-  EXPECT_NEAR(f.instances[0].visible_fraction, 1.0, 1e-12);
+  const AnnotatedFrame f = cam.render(world, Pose2{}, 0);
+  ASSERT_EQ(f.annotation.instances.size(), 1u);
+  EXPECT_NEAR(f.annotation.instances[0].visible_fraction, 1.0, 1e-12);
   // the camera stands mount_z above the ground under its mount (z = 0.0475):
   // the cone's mid-height, at z = 0.4 + 0.1625, relative to it
   const double zc = 0.05 * 0.95;
@@ -298,17 +298,17 @@ TEST(Camera, ConeOnSlopedGroundIsSeenWhereItStands) {
   EXPECT_GT(cam.last_primary_rays(), 200u * 125u + static_cast<unsigned>(b.count));
   EXPECT_LT(cam.last_primary_rays(), 200u * 125u + 4000u);
   const std::size_t q = 3 * (static_cast<std::size_t>(216) * 800 + 10);
-  EXPECT_NE(f.rgb[q + 2], 235);  // not sky
+  EXPECT_NE(f.frame.rgb[q + 2], 235);  // not sky
 }
 
 TEST(Camera, NonFinitePoseGivesABlackUnlabelledFrame) {
   LidarWorld world({Cone{{5.0, 0.0}, ConeColor::Blue}});
   Camera cam(CameraParams{}, 1);
-  const hal::CameraFrame f = cam.render(world, Pose2{std::nan(""), 0.0, 0.0}, 5);
-  EXPECT_EQ(f.rgb.size(), 3u * 800 * 500);
-  EXPECT_EQ(std::count(f.rgb.begin(), f.rgb.end(), 0), 3 * 800 * 500);
-  EXPECT_EQ(std::count(f.labels.begin(), f.labels.end(), -1), 800 * 500);
-  EXPECT_TRUE(f.instances.empty());
+  const AnnotatedFrame f = cam.render(world, Pose2{std::nan(""), 0.0, 0.0}, 5);
+  EXPECT_EQ(f.frame.rgb.size(), 3u * 800 * 500);
+  EXPECT_EQ(std::count(f.frame.rgb.begin(), f.frame.rgb.end(), 0), 3 * 800 * 500);
+  EXPECT_EQ(std::count(f.annotation.labels.begin(), f.annotation.labels.end(), -1), 800 * 500);
+  EXPECT_TRUE(f.annotation.instances.empty());
 }
 
 // every pixel cast on its own (rtcIntersect1, the ray built from the
@@ -344,7 +344,7 @@ void expect_labels_match_brute_force(const GroundParams& ground) {
       yaw += side * 20.0 * kPi / 180.0;
       pos = c.position - rotate({0.95, side * 0.5}, yaw);
     }
-    const hal::CameraFrame f = cam.render(world, Pose2{pos.x, pos.y, yaw}, 0);
+    const AnnotatedFrame f = cam.render(world, Pose2{pos.x, pos.y, yaw}, 0);
     const Eigen::Vector3d o_base = T_base_camera.translation();
     const Vec2 o = pos + rotate({o_base.x(), o_base.y()}, yaw);
     const double oz = world.ground_z(o.x, o.y) + o_base.z();
@@ -369,13 +369,13 @@ void expect_labels_match_brute_force(const GroundParams& ground) {
         rtcIntersect1(world.scene(), &ctx, &rh);
         std::int32_t want = -1;
         if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) want = std::max(-1, world.cone_of(rh.hit.geomID, rh.hit.primID));
-        const std::int32_t got = f.labels[static_cast<std::size_t>(j) * p.width + ii];
+        const std::int32_t got = f.annotation.labels[static_cast<std::size_t>(j) * p.width + ii];
         labelled += want >= 0;
         differ += want != got;
       }
     }
     std::printf("%s ground, pose %d: %zu instances, %d labelled pixels, %d differ\n",
-                flat(ground) ? "flat" : "bumpy", s, f.instances.size(), labelled, differ);
+                flat(ground) ? "flat" : "bumpy", s, f.annotation.instances.size(), labelled, differ);
     EXPECT_GT(labelled, 100) << s;
     EXPECT_LE(differ, 2 + labelled / 1000) << s;
   }

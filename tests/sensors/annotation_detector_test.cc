@@ -1,37 +1,61 @@
-// the annotation detector on hand-made frames (exact tight boxes), its error
-// model against the configured curve (binomial tolerances over many draws),
-// and the frames it must refuse.
-#include "autonomy/perception/detector.h"
+// the annotation detector on hand-made annotated frames (exact tight boxes),
+// its error model against the configured curve (binomial tolerances over many
+// draws), and the frames it must refuse.
+#include "sim/sensors/annotation_detector.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/sensors/camera.h"
 
-namespace paddock::perception {
+namespace paddock::sensors {
 namespace {
 
 // a w x h frame (grey), no cones
-hal::CameraFrame blank(int w = 120, int h = 90) {
-  hal::CameraFrame f;
-  f.width = w;
-  f.height = h;
-  f.rgb.assign(3 * static_cast<std::size_t>(w) * h, 100);
-  f.labels.assign(static_cast<std::size_t>(w) * h, -1);
+AnnotatedFrame blank(int w = 120, int h = 90) {
+  AnnotatedFrame f;
+  f.frame.stamp = 42;
+  f.frame.width = w;
+  f.frame.height = h;
+  f.frame.rgb.assign(3 * static_cast<std::size_t>(w) * h, 100);
+  f.annotation.labels.assign(static_cast<std::size_t>(w) * h, -1);
   return f;
 }
 
 // label the pixels of [i0, i1] x [j0, j1] with id (a solid block)
-void paint(hal::CameraFrame& f, std::int32_t id, int i0, int i1, int j0, int j1) {
+void paint(AnnotatedFrame& f, std::int32_t id, int i0, int i1, int j0, int j1) {
   for (int j = j0; j <= j1; ++j) {
-    for (int i = i0; i <= i1; ++i) f.labels[static_cast<std::size_t>(j) * f.width + i] = id;
+    for (int i = i0; i <= i1; ++i) f.annotation.labels[static_cast<std::size_t>(j) * f.frame.width + i] = id;
   }
 }
 
-hal::CameraInstance inst(std::int32_t id, ConeColor c, double range, double vf = 1.0) {
-  hal::CameraInstance k;
+// the detector's boxes on f (the detections message's), or none when it refuses f
+struct Result {
+  bool ok = false;
+  std::string reason;
+  std::vector<hal::CameraBox> boxes;
+};
+
+Result run(AnnotationDetector& d, const AnnotatedFrame& f) {
+  AnnotationDetection r = d.detect(f.frame, f.annotation);
+  if (r.ok) {
+    // the message is the frame's: its exposure, its size
+    EXPECT_EQ(r.detections.stamp, f.frame.stamp);
+    EXPECT_EQ(r.detections.width, f.frame.width);
+    EXPECT_EQ(r.detections.height, f.frame.height);
+  } else {
+    EXPECT_TRUE(r.detections.boxes.empty());
+  }
+  return {r.ok, r.reason, std::move(r.detections.boxes)};
+}
+Result run(AnnotationDetector&& d, const AnnotatedFrame& f) { return run(d, f); }
+
+CameraInstance inst(std::int32_t id, ConeColor c, double range, double vf = 1.0) {
+  CameraInstance k;
   k.id = id;
   k.color = c;
   k.range = range;
@@ -53,18 +77,18 @@ DetectorParams perfect() {
   return p;
 }
 
-TEST(Detector, NoErrorsGivesTheTightBoxesAndClasses) {
-  hal::CameraFrame f = blank();
+TEST(AnnotationDetector, NoErrorsGivesTheTightBoxesAndClasses) {
+  AnnotatedFrame f = blank();
   // a cone-like blob: a narrow top on a wider base, id 7
   paint(f, 7, 50, 52, 20, 29);
   paint(f, 7, 47, 55, 30, 41);
   // a block, id 3, partly covered by a block of id 9 in front
   paint(f, 3, 10, 19, 60, 79);
   paint(f, 9, 15, 30, 70, 85);
-  f.instances = {inst(7, ConeColor::Blue, 5.0), inst(3, ConeColor::SmallOrange, 8.0, 0.6),
+  f.annotation.instances = {inst(7, ConeColor::Blue, 5.0), inst(3, ConeColor::SmallOrange, 8.0, 0.6),
                  inst(9, ConeColor::BigOrange, 4.0), inst(11, ConeColor::Yellow, 6.0)};  // 11: no pixels
   AnnotationDetector d(perfect(), 1);
-  const DetectorResult r = d.detect(f);
+  const Result r = run(d, f);
   ASSERT_TRUE(r.ok) << r.reason;
   ASSERT_EQ(r.boxes.size(), 3u);
   // pixel (i, j) covers [i, i+1) x [j, j+1): box [i_min, i_max + 1) x [j_min, j_max + 1)
@@ -86,7 +110,7 @@ TEST(Detector, NoErrorsGivesTheTightBoxesAndClasses) {
   EXPECT_DOUBLE_EQ(r.boxes[0].confidence, 1.0);
 }
 
-TEST(Detector, MissCurveIsTheDocumentedOne) {
+TEST(AnnotationDetector, MissCurveIsTheDocumentedOne) {
   const DetectorParams p;  // 2 %, 12 m .. 30 m, 0.3 .. 0.7
   // by hand: x = (r - 12) / 18, s = 3x^2 - 2x^3, p = 0.02 + 0.98 s
   EXPECT_NEAR(miss_probability(p, 5.0, 1.0), 0.02, 1e-12);
@@ -106,11 +130,12 @@ TEST(Detector, MissCurveIsTheDocumentedOne) {
 // the observed miss fraction of instances at (range, visible fraction) over
 // n frames, each frame holding one instance per case
 void expect_miss_rates(const std::vector<std::pair<double, double>>& cases, const std::vector<double>& expected) {
-  hal::CameraFrame f = blank(200, 40);
+  AnnotatedFrame f = blank(200, 40);
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const int i0 = 2 + 20 * static_cast<int>(k);
     paint(f, static_cast<std::int32_t>(k), i0, i0 + 10, 5, 30);
-    f.instances.push_back(inst(static_cast<std::int32_t>(k), ConeColor::Blue, cases[k].first, cases[k].second));
+    f.annotation.instances.push_back(
+        inst(static_cast<std::int32_t>(k), ConeColor::Blue, cases[k].first, cases[k].second));
   }
   DetectorParams p;
   p.min_box_height = 0.0;
@@ -118,10 +143,10 @@ void expect_miss_rates(const std::vector<std::pair<double, double>>& cases, cons
   const int n = 4000;
   std::vector<int> found(cases.size(), 0);
   for (int t = 0; t < n; ++t) {
-    const DetectorResult r = d.detect(f);
+    const Result r = run(d, f);
     ASSERT_TRUE(r.ok);
     // the boxes come in instance order; identify them by their column
-    for (const BoundingBox& b : r.boxes) ++found[static_cast<std::size_t>((b.x_min + b.x_max) / 2.0 / 20.0)];
+    for (const hal::CameraBox& b : r.boxes) ++found[static_cast<std::size_t>((b.x_min + b.x_max) / 2.0 / 20.0)];
   }
   for (std::size_t k = 0; k < cases.size(); ++k) {
     const double q = expected[k], rate = 1.0 - static_cast<double>(found[k]) / n;
@@ -130,23 +155,23 @@ void expect_miss_rates(const std::vector<std::pair<double, double>>& cases, cons
   }
 }
 
-TEST(Detector, MissRateFollowsRangeAndOcclusion) {
+TEST(AnnotationDetector, MissRateFollowsRangeAndOcclusion) {
   expect_miss_rates({{5.0, 1.0}, {15.0, 1.0}, {21.0, 1.0}, {24.0, 1.0}, {31.0, 1.0}},
                     {0.02, 0.0925926, 0.51, 0.7459259, 1.0});
   expect_miss_rates({{5.0, 0.2}, {5.0, 0.5}, {5.0, 0.6}, {5.0, 0.9}, {21.0, 0.5}},
                     {1.0, 0.51, 0.265, 0.02, 1.0 - 0.49 * 0.5});
 }
 
-TEST(Detector, ClassConfusionRates) {
+TEST(AnnotationDetector, ClassConfusionRates) {
   DetectorParams p = perfect();
   p.p_confuse_blue_yellow = 0.2;
   p.p_confuse_orange_size = 0.3;
-  hal::CameraFrame f = blank(200, 40);
+  AnnotatedFrame f = blank(200, 40);
   const ConeColor colours[] = {ConeColor::Blue, ConeColor::Yellow, ConeColor::SmallOrange, ConeColor::BigOrange,
                                ConeColor::Unknown};
   for (int k = 0; k < 5; ++k) {
     paint(f, k, 2 + 20 * k, 12 + 20 * k, 5, 30);
-    f.instances.push_back(inst(k, colours[k], 5.0));
+    f.annotation.instances.push_back(inst(k, colours[k], 5.0));
   }
   AnnotationDetector d(p, 99);
   const int n = 4000;
@@ -154,7 +179,7 @@ TEST(Detector, ClassConfusionRates) {
   const ConeColor other[] = {ConeColor::Yellow, ConeColor::Blue, ConeColor::BigOrange, ConeColor::SmallOrange,
                              ConeColor::Unknown};
   for (int t = 0; t < n; ++t) {
-    const DetectorResult r = d.detect(f);
+    const Result r = run(d, f);
     ASSERT_EQ(r.boxes.size(), 5u);
     for (int k = 0; k < 5; ++k) {
       if (k < 4) {
@@ -171,17 +196,17 @@ TEST(Detector, ClassConfusionRates) {
   }
 }
 
-TEST(Detector, BoxJitterHasTheConfiguredSpreadAndSmallBoxesAreDropped) {
+TEST(AnnotationDetector, BoxJitterHasTheConfiguredSpreadAndSmallBoxesAreDropped) {
   DetectorParams p = perfect();
   p.box_jitter = 0.1;
-  hal::CameraFrame f = blank(200, 120);
+  AnnotatedFrame f = blank(200, 120);
   paint(f, 1, 80, 99, 30, 69);  // 20 x 40 px: std 2 px across, 4 px along
-  f.instances.push_back(inst(1, ConeColor::Blue, 5.0));
+  f.annotation.instances.push_back(inst(1, ConeColor::Blue, 5.0));
   AnnotationDetector d(p, 5);
   const int n = 4000;
   double s[4] = {0, 0, 0, 0}, s2[4] = {0, 0, 0, 0};
   for (int t = 0; t < n; ++t) {
-    const DetectorResult r = d.detect(f);
+    const Result r = run(d, f);
     ASSERT_EQ(r.boxes.size(), 1u);
     const double e[4] = {r.boxes[0].x_min - 80.0, r.boxes[0].x_max - 100.0, r.boxes[0].y_min - 30.0,
                          r.boxes[0].y_max - 70.0};
@@ -200,55 +225,55 @@ TEST(Detector, BoxJitterHasTheConfiguredSpreadAndSmallBoxesAreDropped) {
   // a 5 px tall box is below 6 px and never found; a 6 px one is
   DetectorParams q = perfect();
   q.min_box_height = 6.0;
-  hal::CameraFrame g = blank();
+  AnnotatedFrame g = blank();
   paint(g, 1, 10, 13, 10, 14);
   paint(g, 2, 30, 33, 10, 15);
-  g.instances = {inst(1, ConeColor::Blue, 20.0), inst(2, ConeColor::Yellow, 20.0)};
-  const DetectorResult r = AnnotationDetector(q, 1).detect(g);
+  g.annotation.instances = {inst(1, ConeColor::Blue, 20.0), inst(2, ConeColor::Yellow, 20.0)};
+  const Result r = run(AnnotationDetector(q, 1), g);
   ASSERT_TRUE(r.ok);
   ASSERT_EQ(r.boxes.size(), 1u);
   EXPECT_EQ(r.boxes[0].color, ConeColor::Yellow);
 }
 
-TEST(Detector, HardwareEmptyAndMalformedFrames) {
+TEST(AnnotationDetector, HardwareEmptyAndMalformedFrames) {
   AnnotationDetector d(DetectorParams{}, 1);
-  // a hardware frame: pixels, no annotation
-  hal::CameraFrame hw = blank();
-  hw.labels.clear();
-  DetectorResult r = d.detect(hw);
+  // a frame without annotation (as a hardware camera gives it): pixels only
+  AnnotatedFrame hw = blank();
+  hw.annotation.labels.clear();
+  Result r = run(d, hw);
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.reason.find("annotation"), std::string::npos) << r.reason;
   // no cones: ok, nothing
-  r = d.detect(blank());
+  r = run(d, blank());
   EXPECT_TRUE(r.ok) << r.reason;
   EXPECT_TRUE(r.boxes.empty());
   // malformed
-  hal::CameraFrame bad = blank();
-  bad.rgb.pop_back();
-  r = d.detect(bad);
+  AnnotatedFrame bad = blank();
+  bad.frame.rgb.pop_back();
+  r = run(d, bad);
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.reason.find("rgb"), std::string::npos) << r.reason;
   bad = blank();
-  bad.labels.resize(10);
-  EXPECT_FALSE(d.detect(bad).ok);
+  bad.annotation.labels.resize(10);
+  EXPECT_FALSE(run(d, bad).ok);
   bad = blank();
   paint(bad, 4, 1, 2, 1, 2);  // label without instance
-  r = d.detect(bad);
+  r = run(d, bad);
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.reason.find("no instance"), std::string::npos) << r.reason;
   bad = blank();
-  bad.instances = {inst(2, ConeColor::Blue, 3.0), inst(2, ConeColor::Blue, 3.0)};
-  EXPECT_FALSE(d.detect(bad).ok);
+  bad.annotation.instances = {inst(2, ConeColor::Blue, 3.0), inst(2, ConeColor::Blue, 3.0)};
+  EXPECT_FALSE(run(d, bad).ok);
   bad = blank();
-  bad.labels[5] = -3;
-  EXPECT_FALSE(d.detect(bad).ok);
-  EXPECT_FALSE(d.detect(hal::CameraFrame{}).ok);
+  bad.annotation.labels[5] = -3;
+  EXPECT_FALSE(run(d, bad).ok);
+  EXPECT_FALSE(run(d, AnnotatedFrame{}).ok);
   bad = blank();
-  bad.width = -4;
-  EXPECT_FALSE(d.detect(bad).ok);
+  bad.frame.width = -4;
+  EXPECT_FALSE(run(d, bad).ok);
 }
 
-TEST(Detector, ParamsValidation) {
+TEST(AnnotationDetector, ParamsValidation) {
   DetectorParams p;
   EXPECT_EQ(validate(p), "");
   p.range_max = p.range_full;
@@ -261,15 +286,15 @@ TEST(Detector, ParamsValidation) {
   EXPECT_THROW(AnnotationDetector(p, 1), std::invalid_argument);
 }
 
-TEST(Detector, DeterministicPerSeed) {
-  hal::CameraFrame f = blank();
+TEST(AnnotationDetector, DeterministicPerSeed) {
+  AnnotatedFrame f = blank();
   for (int k = 0; k < 5; ++k) {
     paint(f, k, 2 + 20 * k, 12 + 20 * k, 5, 30);
-    f.instances.push_back(inst(k, ConeColor::Blue, 10.0 + 3 * k, 0.5 + 0.1 * k));
+    f.annotation.instances.push_back(inst(k, ConeColor::Blue, 10.0 + 3 * k, 0.5 + 0.1 * k));
   }
   AnnotationDetector a(DetectorParams{}, 7), b(DetectorParams{}, 7);
   for (int t = 0; t < 50; ++t) {
-    const DetectorResult ra = a.detect(f), rb = b.detect(f);
+    const Result ra = run(a, f), rb = run(b, f);
     ASSERT_EQ(ra.boxes.size(), rb.boxes.size());
     for (std::size_t k = 0; k < ra.boxes.size(); ++k) {
       EXPECT_EQ(ra.boxes[k].x_min, rb.boxes[k].x_min);
@@ -279,7 +304,7 @@ TEST(Detector, DeterministicPerSeed) {
   }
 }
 
-TEST(Detector, RenderedFrameGivesOneBoxPerVisibleCone) {
+TEST(AnnotationDetector, RenderedFrameGivesOneBoxPerVisibleCone) {
   // the simulator's camera: a gate of cones ahead, perfect detector
   const std::vector<Cone> cones = {{{6.0, 1.5}, ConeColor::Blue},
                                    {{6.0, -1.5}, ConeColor::Yellow},
@@ -289,12 +314,12 @@ TEST(Detector, RenderedFrameGivesOneBoxPerVisibleCone) {
                                    {{-3.0, 0.0}, ConeColor::Blue}};  // behind the car
   sensors::LidarWorld world(cones);
   sensors::Camera cam(sensors::CameraParams{}, 1);
-  const hal::CameraFrame f = cam.render(world, Pose2{}, 0);
-  ASSERT_EQ(f.instances.size(), 5u);
-  const DetectorResult r = AnnotationDetector(perfect(), 1).detect(f);
+  const AnnotatedFrame f = cam.render(world, Pose2{}, 0);
+  ASSERT_EQ(f.annotation.instances.size(), 5u);
+  const Result r = run(AnnotationDetector(perfect(), 1), f);
   ASSERT_TRUE(r.ok);
   ASSERT_EQ(r.boxes.size(), 5u);
-  const CameraCalibration k = cam.calibration();
+  const perception::CameraCalibration k = cam.calibration();
   for (std::size_t i = 0; i < 5; ++i) {
     EXPECT_EQ(r.boxes[i].color, cones[i].color);
     // the box holds the projection of the cone's mid-height point (by hand:
@@ -313,4 +338,4 @@ TEST(Detector, RenderedFrameGivesOneBoxPerVisibleCone) {
 }
 
 }  // namespace
-}  // namespace paddock::perception
+}  // namespace paddock::sensors
