@@ -1,36 +1,26 @@
 #include "autonomy/perception/perception.h"
 
 #include <cmath>
-#include <stdexcept>
 #include <utility>
 
 namespace paddock::perception {
 
-std::string validate(const PerceptionParams& p) {
-  if (std::string why = validate(p.odometry); !why.empty()) return "odometry." + why;
-  if (std::string why = validate(p.lidar); !why.empty()) return "lidar." + why;
-  if (std::string why = validate(p.detector); !why.empty()) return "detector." + why;
-  if (std::string why = validate(p.fusion); !why.empty()) return "fusion." + why;
-  if (p.use_camera) {
-    const CameraCalibration& c = p.camera;
-    if (c.width <= 0 || c.height <= 0) return "camera: width and height must be > 0";
-    if (!(c.fx > 0.0) || !(c.fy > 0.0)) return "camera: fx and fy must be > 0";
+std::string PerceptionParams::check() const {
+  if (const std::string why = validate(detector); !why.empty()) return "detector." + why;
+  if (use_camera) {
+    const CameraCalibration& c = camera;
+    if (c.width <= 0 || c.height <= 0) return "camera.width and camera.height must be > 0 px";
+    if (!(c.fx > 0.0) || !(c.fy > 0.0)) return "camera.fx and camera.fy must be > 0 px";
     if (!std::isfinite(c.cx) || !std::isfinite(c.cy) || !c.T_camera_base.matrix().allFinite())
-      return "camera: cx, cy and T_camera_base must be finite";
+      return "camera.cx, camera.cy and camera.T_camera_base must be finite";
   }
-  if (!(p.camera_sync_tolerance >= 0.0)) return "camera_sync_tolerance must be >= 0";
   return "";
 }
 
-namespace {
-const PerceptionParams& checked(const PerceptionParams& p) {
-  if (std::string why = validate(p); !why.empty()) throw std::invalid_argument("PerceptionParams: " + why);
-  return p;
-}
-}  // namespace
-
 Perception::Perception(const PerceptionParams& params, std::uint64_t seed)
-    : params_(checked(params)), odometry_(params.odometry), pipeline_(params.lidar) {
+    : params_(params::require_valid(params, "PerceptionParams")),
+      odometry_(params.odometry),
+      pipeline_(params.lidar) {
   if (params_.use_camera) detector_ = std::make_unique<AnnotationDetector>(params_.detector, seed);
 }
 

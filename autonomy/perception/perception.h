@@ -22,6 +22,7 @@
 #include <optional>
 #include <string>
 
+#include "autonomy/common/params.h"
 #include "autonomy/hal/messages.h"
 #include "autonomy/perception/detector.h"
 #include "autonomy/perception/fusion.h"
@@ -32,19 +33,32 @@
 namespace paddock::perception {
 
 struct PerceptionParams {
+  // not visited: the stack sets it from the perception mode ([autonomy]
+  // perception: lidar_camera uses the camera, lidar not)
   bool use_camera = true;
   OdometryParams odometry;
-  LidarPipelineParams lidar;  // its calibration: the LiDAR's mounting and beams
-  CameraCalibration camera;   // K and T_camera_base
+  // its calibration: the LiDAR's mounting and beams
+  LidarPipelineParams lidar;
+  // K and T_camera_base; not visited: the runner fills it from the camera's
+  // model and mounting ([camera]); check() checks it when use_camera
+  CameraCalibration camera;
+  // not visited here (the detector has no parameter list of its own; its
+  // [detector] keys are the scenario's): check() runs its validate()
   DetectorParams detector;
   FusionParams fusion;
-  // a camera frame serves the scan during whose rotation it was exposed, give
-  // or take this much (s)
   double camera_sync_tolerance = 0.02;
-};
 
-// "" when every field is usable, else the first problem ("lidar.…", "camera.…")
-std::string validate(const PerceptionParams& p);
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(odometry), "the dead reckoning that motion-corrects the scans");
+    v.section(PADDOCK_PARAM(lidar), "the LiDAR pipeline");
+    v.section(PADDOCK_PARAM(fusion), "the LiDAR-camera fusion");
+    v(PADDOCK_PARAM(camera_sync_tolerance), {"s", params::in(0.0, 1.0),
+                                             "a camera frame serves the rotation it was exposed in, give or take this"});
+  }
+  // the detector's parameters, then the camera's calibration when use_camera
+  std::string check() const;
+};
 
 // what the last scan went through, for plots and diagnostics
 struct PerceptionFrame {
@@ -67,7 +81,7 @@ struct PerceptionStats {
 
 class Perception {
  public:
-  // throws std::invalid_argument when validate(params) fails; the seed starts
+  // throws std::invalid_argument when params::validate(params) fails; the seed starts
   // the detector's random stream
   Perception(const PerceptionParams& params, std::uint64_t seed);
 

@@ -589,7 +589,7 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   if (const std::string why = params::validate(s.lidar); !why.empty()) throw UserError(path + ": [lidar] " + why);
   if (const std::string why = sensors::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
   if (const std::string why = sensors::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
-  if (const std::string why = perception::validate(stack_params(s).perception); !why.empty()) {
+  if (const std::string why = params::validate(stack_params(s).perception); !why.empty()) {
     // "detector.range_max ..." is a [detector] key; the rest are [perception]'s or derived
     if (why.rfind("detector.", 0) == 0) throw UserError(path + ": [detector] " + why.substr(9));
     throw UserError(path + ": [perception] " + why);
