@@ -582,7 +582,7 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   }
   if (const char* why = control::validate(s.control, stack_params(s).vehicle)) throw UserError(path + ": [control] " + why);
   if (const std::string why = sensors::validate(s.cone_sensor); !why.empty()) throw UserError(path + ": [cone_sensor] " + why);
-  if (const auto why = planning::validate(s.planning)) throw UserError(path + ": [planning] " + *why);
+  if (const std::string why = params::validate(s.planning); !why.empty()) throw UserError(path + ": [planning] " + why);
   if (const std::string why = sensors::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
   if (const std::string why = sensors::validate(s.wheel_speeds); !why.empty()) throw UserError(path + ": [wheel_speeds] " + why);
   if (const std::string why = sensors::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
