@@ -580,7 +580,10 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
     throw UserError(path + ": [sim] physics_rate (" + std::to_string(s.sim.physics_rate) +
                     " Hz) must be a whole multiple of control_rate and log_rate");
   }
-  if (const char* why = control::validate(s.control, stack_params(s).vehicle)) throw UserError(path + ": [control] " + why);
+  if (const std::string why = params::validate(s.control); !why.empty()) throw UserError(path + ": [control] " + why);
+  if (const std::string why = params::validate(stack_params(s).vehicle); !why.empty()) {
+    throw UserError(path + ": [control] vehicle." + why);
+  }
   if (const std::string why = sensors::validate(s.cone_sensor); !why.empty()) throw UserError(path + ": [cone_sensor] " + why);
   if (const std::string why = params::validate(s.planning); !why.empty()) throw UserError(path + ": [planning] " + why);
   if (const std::string why = sensors::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
