@@ -42,39 +42,6 @@ const char* to_string(Status s) {
   return "bad_state";
 }
 
-const char* validate(const ControlParams& p, const VehicleKnowledge& v) {
-  if (!(p.stanley.k >= 0.0)) return "stanley.k must be >= 0";
-  if (!(p.stanley.k_soft > 0.0)) return "stanley.k_soft must be > 0";
-  if (!(p.pure_pursuit.L_min > 0.0)) return "pure_pursuit.L_min must be > 0";
-  if (!(p.pure_pursuit.k_v >= 0.0)) return "pure_pursuit.k_v must be >= 0";
-  if (!(p.combined.k_min >= 0.0 && p.combined.k_min <= 1.0)) return "combined.k_min must be in [0, 1]";
-  if (!(p.combined.k_max >= p.combined.k_min && p.combined.k_max <= 1.0))
-    return "combined.k_max must be in [k_min, 1]";
-  if (!(p.combined.kappa_ref > 0.0)) return "combined.kappa_ref must be > 0";
-  if (!(p.combined.k_curve >= 0.0)) return "combined.k_curve must be >= 0";
-  if (!(p.k_d_yaw >= 0.0)) return "k_d_yaw must be >= 0";
-  if (!(p.longitudinal.kp >= 0.0)) return "longitudinal.kp must be >= 0";
-  if (!(p.longitudinal.ki >= 0.0)) return "longitudinal.ki must be >= 0";
-  if (!(p.longitudinal.integral_limit >= 0.0)) return "longitudinal.integral_limit must be >= 0";
-  if (!(p.longitudinal.integral_band > 0.0)) return "longitudinal.integral_band must be > 0";
-  if (!(p.longitudinal.feedforward_gain >= 0.0)) return "longitudinal.feedforward_gain must be >= 0";
-  if (!(p.longitudinal.speed_preview_time >= 0.0)) return "longitudinal.speed_preview_time must be >= 0";
-  if (!(p.longitudinal.stop_speed >= 0.0)) return "longitudinal.stop_speed must be >= 0";
-  if (!(p.projection_window > 0.0)) return "projection_window must be > 0";
-  if (!(p.relocalize_distance > 0.0)) return "relocalize_distance must be > 0";
-  if (!(v.mass > 0.0)) return "vehicle mass must be > 0";
-  if (!(v.lf > 0.0 && v.lr > 0.0)) return "vehicle lf and lr must be > 0";
-  if (!(std::abs(v.wheelbase - (v.lf + v.lr)) <= 1e-3)) return "vehicle wheelbase must equal lf + lr";
-  if (!(v.front_cornering_stiffness > 0.0)) return "vehicle front cornering stiffness must be > 0";
-  if (!(v.max_steering_angle > 0.0 && v.max_steering_angle < 0.5 * kPi))
-    return "vehicle max steering angle must be in (0, pi/2)";
-  if (!(v.max_drive_force > 0.0)) return "vehicle max drive force must be > 0";
-  if (!(v.max_brake_force > 0.0)) return "vehicle max brake force must be > 0";
-  if (!(v.drag_coefficient >= 0.0)) return "vehicle drag coefficient must be >= 0";
-  if (!(v.rolling_resistance >= 0.0)) return "vehicle rolling resistance must be >= 0";
-  return nullptr;
-}
-
 Controller::Controller(const ControlParams& params, const VehicleKnowledge& vehicle)
     : params_(params), vehicle_(vehicle), speed_model_(speed_model_of(vehicle)) {}
 

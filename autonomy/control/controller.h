@@ -2,10 +2,13 @@
 // the controller of the car: the lateral law (combined Stanley / pure pursuit,
 // lateral.h) and the speed loop (longitudinal.h) on one reference trajectory,
 // run once per control cycle (100 Hz by default).
+#include <cmath>
 #include <cstddef>
 #include <limits>
+#include <string>
 
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 #include "autonomy/common/trajectory.h"
 #include "autonomy/control/lateral.h"
 #include "autonomy/control/longitudinal.h"
@@ -14,26 +17,49 @@ namespace paddock::control {
 
 // what the stack knows of its car. Defaults: the AMZ FSSIM "gotthard" car
 // (m 190 kg, lf = lr = 0.765 m, Pacejka B 12.56 C 1.38 D 1.60, motor 5000 N,
-// drag 0.7 v^2, rolling resistance 180 N)
+// drag 0.7 v^2, rolling resistance 180 N). Not a parameter set a user
+// writes: the runner fills it from the vehicle ([vehicle], see
+// stack_params), so StackParams does not visit it (its check() checks it);
+// the visit below gives the units and bounds params::validate checks.
 struct VehicleKnowledge {
-  double mass = 190.0;      // kg
-  double lf = 0.765;        // CG to front axle (m)
-  double lr = 0.765;        // CG to rear axle (m)
-  double wheelbase = 1.53;  // rear axle to front axle (m); should equal lf + lr
-  // front axle cornering stiffness (N/rad): B C D Fz_front at the static load
-  // Fz_front = m g lr / L = 931.95 N -> 27.73 * 931.95 = 25,845 N/rad
+  double mass = 190.0;
+  double lf = 0.765;
+  double lr = 0.765;
+  double wheelbase = 1.53;
+  // B C D Fz_front at the static load Fz_front = m g lr / L = 931.95 N ->
+  // 27.73 * 931.95 = 25,845 N/rad
   double front_cornering_stiffness = front_axle_cornering_stiffness(12.56, 1.38, 1.60, 190.0, 0.765, 0.765);
-  // largest steering angle at the wheels (rad): a 9 m hairpin (centreline
-  // radius ~3 m) needs atan(1.53 / 3) = 0.47 rad kinematically; EUFS has +-0.52
+  // a 9 m hairpin (centreline radius ~3 m) needs atan(1.53 / 3) = 0.47 rad
+  // kinematically; EUFS has +-0.52
   double max_steering_angle = 0.5;
-  double max_drive_force = 5000.0;  // at throttle 1 (N)
-  // at brake 1 (N): about what the tyres carry without downforce, D m g = 1.6 * 190 * 9.81
+  double max_drive_force = 5000.0;
+  // about what the tyres carry without downforce, D m g = 1.6 * 190 * 9.81
   double max_brake_force = 3000.0;
-  double drag_coefficient = 0.7;      // F_drag = c v^2 (N s^2/m^2)
-  double rolling_resistance = 180.0;  // N
+  double drag_coefficient = 0.7;
+  double rolling_resistance = 180.0;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(mass), {"kg", params::above(0.0), "the car's mass"});
+    v(PADDOCK_PARAM(lf), {"m", params::above(0.0), "CG to front axle"});
+    v(PADDOCK_PARAM(lr), {"m", params::above(0.0), "CG to rear axle"});
+    v(PADDOCK_PARAM(wheelbase), {"m", params::above(0.0), "rear axle to front axle (lf + lr)"});
+    v(PADDOCK_PARAM(front_cornering_stiffness), {"N/rad", params::above(0.0), "front axle cornering stiffness"});
+    v(PADDOCK_PARAM(max_steering_angle), {"rad", params::Bounds{0.0, 0.5 * kPi, true, true}, "largest steering angle at the wheels"});
+    v(PADDOCK_PARAM(max_drive_force), {"N", params::above(0.0), "drive force at throttle 1"});
+    v(PADDOCK_PARAM(max_brake_force), {"N", params::above(0.0), "brake force at brake 1"});
+    v(PADDOCK_PARAM(drag_coefficient), {"N s^2/m^2", params::at_least(0.0), "aerodynamic drag F = c v^2"});
+    v(PADDOCK_PARAM(rolling_resistance), {"N", params::at_least(0.0), "constant resistance while moving"});
+  }
+  std::string check() const {
+    if (std::abs(wheelbase - (lf + lr)) <= 1e-3) return "";
+    return "wheelbase must equal lf + lr (got " + params::number(wheelbase) + ", lf + lr = " + params::number(lf + lr) + ")";
+  }
 };
 
 struct ControlParams {
+  static constexpr params::Choice<LateralMode> kLateralNames[] = {
+      {"combined", LateralMode::Combined}, {"stanley", LateralMode::Stanley}, {"pure_pursuit", LateralMode::PurePursuit}};
   LateralMode lateral = LateralMode::Combined;
   // Stanley: k 2.5 1/s, k_soft 1 m/s (the pair of the ORACLES figures);
   // at 15 m/s a 0.5 m error asks 0.08 rad, gentle enough for a 190 kg car
@@ -47,22 +73,32 @@ struct ControlParams {
   // in corners of radius 10 m and below (pure pursuit turns in early and does
   // not overshoot the apex)
   CombinedParams combined;
-  // yaw-rate damping (s): delta -= k_d_yaw (r_meas - r_traj). At 15 m/s the
-  // kinematic yaw-rate gain is v / L = 9.8 1/s, so 0.05 s closes a damping
-  // loop of ~0.5: damps the yaw transient without fighting the steering
+  // delta -= k_d_yaw (r_meas - r_traj). At 15 m/s the kinematic yaw-rate
+  // gain is v / L = 9.8 1/s, so 0.05 s closes a damping loop of ~0.5: damps
+  // the yaw transient without fighting the steering
   double k_d_yaw = 0.05;
   LongitudinalParams longitudinal;
   // the projection searches +-projection_window of arc length around the last
   // cycle's s (advanced by v dt), so a track that passes near itself cannot
   // make it jump; a full search runs on the first call, after reset(), when
   // the trajectory changes, and when the windowed result lies farther than
-  // relocalize_distance from the car (m)
-  double projection_window = 3.0;    // m
-  double relocalize_distance = 3.0;  // m
-};
+  // relocalize_distance from the car
+  double projection_window = 3.0;
+  double relocalize_distance = 3.0;
 
-// the first broken rule of a parameter set, or nullptr when it is valid
-const char* validate(const ControlParams& p, const VehicleKnowledge& v);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(lateral), kLateralNames, "lateral control law");
+    v.section(PADDOCK_PARAM(stanley), "the Stanley law");
+    v.section(PADDOCK_PARAM(pure_pursuit), "the pure pursuit law");
+    v.section(PADDOCK_PARAM(combined), "the curvature-weighted combination of pure pursuit and Stanley");
+    v(PADDOCK_PARAM(k_d_yaw), {"s", params::in(0.0, 10.0), "yaw-rate damping gain"});
+    v.section(PADDOCK_PARAM(longitudinal), "the speed loop");
+    v(PADDOCK_PARAM(projection_window), {"m", params::in(0.1, 100.0), "arc-length window of the path projection"});
+    v(PADDOCK_PARAM(relocalize_distance), {"m", params::above(0.0),
+                                           "a windowed projection farther than this from the car runs a full search"});
+  }
+};
 
 enum class Status { Ok, NoTrajectory, BadState };
 

@@ -6,7 +6,10 @@
 //
 // Conventions (ISO / REP-103): steering angle delta > 0 turns LEFT; angles are
 // counter-clockwise; the vehicle `base` frame sits at the rear axle centre.
+#include <string>
+
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 #include "autonomy/common/trajectory.h"
 
 namespace paddock::control {
@@ -15,25 +18,51 @@ enum class LateralMode { Combined, Stanley, PurePursuit };
 
 const char* to_string(LateralMode m);
 
+// delta = psi_e + atan(k e / (k_soft + v)) (+ theta_ss)
 struct StanleyParams {
-  double k = 2.5;       // cross-track gain (1/s): atan(k e / (k_soft + v))
-  double k_soft = 1.0;  // softening speed (m/s): keeps the gain finite at standstill
-  // add Hoffmann's steady-state yaw theta_ss (the front axle's slip angle in a
-  // steady turn, see steady_state_yaw) to the kinematic law
+  double k = 2.5;
+  // keeps the gain finite at standstill
+  double k_soft = 1.0;
+  // theta_ss: the front axle's slip angle in a steady turn, see
+  // steady_state_yaw
   bool use_steady_state_yaw = true;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(k), {"1/s", params::in(0.0, 100.0), "Stanley cross-track gain"});
+    v(PADDOCK_PARAM(k_soft), {"m/s", params::above_up_to(0.0, 100.0), "Stanley softening speed"});
+    v(PADDOCK_PARAM(use_steady_state_yaw), "add Hoffmann's steady-state yaw to Stanley");
+  }
 };
 
+// L_d = L_min + k_v v
 struct PurePursuitParams {
-  double L_min = 2.5;  // look-ahead distance at standstill (m)
-  double k_v = 0.15;   // look-ahead growth with speed (s): L_d = L_min + k_v v
+  double L_min = 2.5;
+  double k_v = 0.15;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(L_min), {"m", params::in(0.1, 100.0), "pure pursuit look-ahead at standstill L_min"});
+    v(PADDOCK_PARAM(k_v), {"s", params::in(0.0, 10.0), "pure pursuit look-ahead growth k_v"});
+  }
 };
 
 // k_pp = clamp(min(k_min + |kappa| / kappa_ref * k_curve, k_max), 0, 1)
 struct CombinedParams {
-  double k_min = 0.2;       // pure pursuit weight on a straight (-)
-  double k_max = 0.8;       // largest pure pursuit weight (-)
-  double kappa_ref = 0.1;   // curvature scale (1/m): a 10 m radius adds k_curve
-  double k_curve = 0.6;     // weight added per kappa_ref of curvature (-)
+  double k_min = 0.2;
+  double k_max = 0.8;
+  // a 10 m radius adds k_curve
+  double kappa_ref = 0.1;
+  double k_curve = 0.6;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(k_min), {"", params::fraction(), "pure pursuit weight on a straight"});
+    v(PADDOCK_PARAM(k_max), {"", params::fraction(), "largest pure pursuit weight (>= k_min)"});
+    v(PADDOCK_PARAM(kappa_ref), {"1/m", params::in(1e-6, 100.0), "curvature scale"});
+    v(PADDOCK_PARAM(k_curve), {"", params::in(0.0, 10.0), "weight added per kappa_ref of curvature"});
+  }
+  std::string check() const { return k_max >= k_min ? "" : "k_max must be >= k_min"; }
 };
 
 // Stanley, kinematic part: delta = psi_e + atan(k e / (k_soft + v)) (rad).

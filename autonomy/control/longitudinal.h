@@ -14,19 +14,35 @@
 // u = F / F_brake,max when F < 0 (brake), each clamped to [0, 1]. Gains in
 // acceleration units keep their meaning when the car's mass or motor changes,
 // and the separate force scales are the separate throttle and brake gains.
+#include "autonomy/common/params.h"
+
 namespace paddock::control {
 
 struct LongitudinalParams {
-  double kp = 2.0;  // acceleration per speed error (1/s): a 1 m/s error asks 2 m/s^2; time constant 0.5 s
-  double ki = 0.5;  // integral gain (1/s^2): integrates model errors out in a few seconds
-  double integral_limit = 2.0;     // bound on the integral's acceleration contribution |I| (m/s^2)
-  // the integrator runs only while |e| < integral_band (m/s): it is there for
-  // the small steady-state errors of a wrong model, not for the big
-  // transients of a launch or a braking zone, which kp and the feedforward handle
+  // a 1 m/s error asks 2 m/s^2; time constant 0.5 s
+  double kp = 2.0;
+  // integrates model errors out in a few seconds
+  double ki = 0.5;
+  double integral_limit = 2.0;
+  // the integrator is there for the small steady-state errors of a wrong
+  // model, not for the big transients of a launch or a braking zone, which
+  // kp and the feedforward handle
   double integral_band = 1.0;
-  double feedforward_gain = 1.0;   // scale of the model feedforward (-); 0 switches it off
-  double speed_preview_time = 0.2; // the reference speed is read this far ahead (s) for actuator lag
-  double stop_speed = 0.1;         // at a reference of 0 and a speed below this, hold full brake (m/s)
+  double feedforward_gain = 1.0;
+  // for actuator lag
+  double speed_preview_time = 0.2;
+  double stop_speed = 0.1;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(kp), {"1/s", params::in(0.0, 100.0), "speed loop proportional gain (acceleration per speed error)"});
+    v(PADDOCK_PARAM(ki), {"1/s^2", params::in(0.0, 100.0), "speed loop integral gain"});
+    v(PADDOCK_PARAM(integral_limit), {"m/s^2", params::in(0.0, 100.0), "bound of the integral term |I|"});
+    v(PADDOCK_PARAM(integral_band), {"m/s", params::above(0.0), "the integrator runs only while the speed error is below this"});
+    v(PADDOCK_PARAM(feedforward_gain), {"", params::in(0.0, 2.0), "scale of the model feedforward (0: off)"});
+    v(PADDOCK_PARAM(speed_preview_time), {"s", params::in(0.0, 5.0), "the reference speed is read this far ahead"});
+    v(PADDOCK_PARAM(stop_speed), {"m/s", params::at_least(0.0), "at a reference of 0 and a speed below this, hold full brake"});
+  }
 };
 
 // what the speed loop knows of the car

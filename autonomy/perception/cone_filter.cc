@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
-#include <stdexcept>
 
 namespace paddock::perception {
 
@@ -27,44 +25,9 @@ double cone_radius(bool big, double h) {
 
 }  // namespace
 
-std::string validate(const ConeFilterParams& p) {
-  std::ostringstream os;
-  if (!finite(p.reconstruction_radius) || !(p.reconstruction_radius > 0.0)) {
-    os << "reconstruction_radius must be finite and > 0 m (got " << p.reconstruction_radius << ")";
-  } else if (!finite(p.reconstruction_margin) || !(p.reconstruction_margin >= 0.0)) {
-    os << "reconstruction_margin must be finite and >= 0 m (got " << p.reconstruction_margin << ")";
-  } else if (!finite(p.local_ground_inner) || !(p.local_ground_inner >= 0.0)) {
-    os << "local_ground_inner must be finite and >= 0 m (got " << p.local_ground_inner << ")";
-  } else if (!finite(p.local_ground_outer) || !(p.local_ground_outer > p.local_ground_inner)) {
-    os << "local_ground_outer must be finite and > local_ground_inner m (got " << p.local_ground_outer << ")";
-  } else if (p.local_ground_min_points < 1) {
-    os << "local_ground_min_points must be >= 1 (got " << p.local_ground_min_points << ")";
-  } else if (p.min_points < 1) {
-    os << "min_points must be >= 1 (got " << p.min_points << ")";
-  } else if (!finite(p.max_extent) || !(p.max_extent > 0.0)) {
-    os << "max_extent must be finite and > 0 m (got " << p.max_extent << ")";
-  } else if (!finite(p.min_height)) {
-    os << "min_height must be finite m (got " << p.min_height << ")";
-  } else if (!finite(p.max_height) || !(p.max_height > p.min_height)) {
-    os << "max_height must be finite and > min_height m (got " << p.max_height << ")";
-  } else if (!finite(p.max_asymmetry) || !(p.max_asymmetry > 0.0)) {
-    os << "max_asymmetry must be finite and > 0 m (got " << p.max_asymmetry << ")";
-  } else if (!finite(p.max_width_growth) || !(p.max_width_growth >= 0.0)) {
-    os << "max_width_growth must be finite and >= 0 m (got " << p.max_width_growth << ")";
-  } else if (!finite(p.min_count_ratio) || !(p.min_count_ratio >= 0.0)) {
-    os << "min_count_ratio must be finite and >= 0 (got " << p.min_count_ratio << ")";
-  } else if (!finite(p.max_count_ratio) || !(p.max_count_ratio > p.min_count_ratio)) {
-    os << "max_count_ratio must be finite and > min_count_ratio (got " << p.max_count_ratio << ")";
-  } else if (!finite(p.big_cone_height) || !(p.big_cone_height > 0.0)) {
-    os << "big_cone_height must be finite and > 0 m (got " << p.big_cone_height << ")";
-  }
-  return os.str();
-}
-
 ConeFilter::ConeFilter(const ConeFilterParams& params, const LidarCalibration& calibration)
     : params_(params), calib_(calibration) {
-  std::string err = validate(params_);
-  if (!err.empty()) throw std::invalid_argument("ConeFilterParams: " + err);
+  params::require_valid(params_, "ConeFilterParams");
   params::require_valid(calib_, "LidarCalibration");
   // one channel: no vertical spacing; take a narrow 1 deg beam
   res_v_ = calib_.channels > 1 ? (calib_.elevation_max - calib_.elevation_min) / (calib_.channels - 1)

@@ -43,6 +43,7 @@
 
 #include <Eigen/Core>
 
+#include "autonomy/common/params.h"
 #include "autonomy/perception/clustering.h"
 #include "autonomy/perception/ground_segmentation.h"
 #include "autonomy/perception/motion_correction.h"
@@ -51,37 +52,57 @@ namespace paddock::perception {
 
 struct ConeFilterParams {
   // reconstruction: a big cone's base radius (0.1425 m) plus range noise
-  double reconstruction_radius = 0.2;   // m, > 0
-  double reconstruction_margin = 0.02;  // m, >= 0
+  double reconstruction_radius = 0.2;
+  double reconstruction_margin = 0.02;
   // the ground under a cone: the median height of the ground returns in the
   // ring [local_ground_inner, local_ground_outer] around its axis, when there
   // are at least local_ground_min_points of them (else the region's plane,
   // which on a bumpy ground can be off by the bumps: a small cone's 0.325 m
   // would then pass for a big cone's 0.42 m)
-  double local_ground_inner = 0.25;  // m, >= 0
-  double local_ground_outer = 1.0;   // m, > local_ground_inner
-  int local_ground_min_points = 4;   // -, >= 1
+  double local_ground_inner = 0.25;
+  double local_ground_outer = 1.0;
+  int local_ground_min_points = 4;
   // count floor: two returns (a small cone gets ~5 on three rings at 15 m,
   // ~2 on two at 20 m with the default 0.5 deg sensor)
-  int min_points = 2;  // -, >= 1
+  int min_points = 2;
   // size
-  double max_extent = 0.45;  // m, > 0
-  double min_height = 0.08;  // m
-  double max_height = 0.6;   // m, > min_height
+  double max_extent = 0.45;
+  double min_height = 0.08;
+  double max_height = 0.6;
   // shape
-  double max_asymmetry = 0.08;     // m, > 0
-  double max_width_growth = 0.06;  // m, >= 0
-  // density, relative to E(d)
-  double min_count_ratio = 0.2;  // -, >= 0
-  double max_count_ratio = 4.0;  // -, > min_count_ratio; a big cone has ~2x a small one's area
-  // a cluster whose top return reaches this is a big cone (for the centre's
-  // profile; between the small cone's 0.325 m and the big one's 0.505 m)
-  double big_cone_height = 0.42;  // m
-};
+  double max_asymmetry = 0.08;
+  double max_width_growth = 0.06;
+  // density, relative to E(d); a big cone has ~2x a small one's area
+  double min_count_ratio = 0.2;
+  double max_count_ratio = 4.0;
+  // between the small cone's 0.325 m and the big one's 0.505 m
+  double big_cone_height = 0.42;
 
-// "" when every field is usable, else the first problem, starting with the
-// field name
-std::string validate(const ConeFilterParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(reconstruction_radius), {"m", params::above(0.0), "ground returns within this of a cone's axis are given back to it"});
+    v(PADDOCK_PARAM(reconstruction_margin), {"m", params::at_least(0.0),
+                                             "... when they stand more than this above the local ground"});
+    v(PADDOCK_PARAM(local_ground_inner), {"m", params::at_least(0.0), "the ring of ground returns under a cone starts this far from its axis"});
+    v(PADDOCK_PARAM(local_ground_outer), {"m", params::above(0.0), "... and ends this far (> local_ground_inner)"});
+    v(PADDOCK_PARAM(local_ground_min_points), {"", params::at_least(1), "fewer ground returns in the ring: the region's plane is the ground"});
+    v(PADDOCK_PARAM(min_points), {"", params::at_least(1), "a cone has at least this many returns"});
+    v(PADDOCK_PARAM(max_extent), {"m", params::above(0.0), "largest diagonal of a cone's x, y bounding box"});
+    v(PADDOCK_PARAM(min_height), {"m", params::any(), "lowest top return above the ground"});
+    v(PADDOCK_PARAM(max_height), {"m", params::any(), "highest top return above the ground (> min_height)"});
+    v(PADDOCK_PARAM(max_asymmetry), {"m", params::above(0.0), "largest offset of the returns' mean from the middle of their extent, across the line of sight"});
+    v(PADDOCK_PARAM(max_width_growth), {"m", params::at_least(0.0), "the upper half of a cone is at most this much wider than the lower half"});
+    v(PADDOCK_PARAM(min_count_ratio), {"", params::at_least(0.0), "fewest returns, relative to the expected count E(d)"});
+    v(PADDOCK_PARAM(max_count_ratio), {"", params::above(0.0), "most returns, relative to E(d) (> min_count_ratio)"});
+    v(PADDOCK_PARAM(big_cone_height), {"m", params::above(0.0), "a cluster whose top return reaches this is a big cone"});
+  }
+  std::string check() const {
+    if (!(local_ground_outer > local_ground_inner)) return "local_ground_outer must be > local_ground_inner";
+    if (!(max_height > min_height)) return "max_height must be > min_height";
+    if (!(max_count_ratio > min_count_ratio)) return "max_count_ratio must be > min_count_ratio";
+    return "";
+  }
+};
 
 // an accepted cone: its returns are members[begin, end) of the filter's
 // member list (cluster returns and the reconstructed ones)
@@ -105,7 +126,8 @@ struct ConeFilterStats {
 
 class ConeFilter {
  public:
-  // throws std::invalid_argument when validate(params) or validate(calibration) fails
+  // throws std::invalid_argument when params::validate(params) or
+  // params::validate(calibration) fails
   ConeFilter(const ConeFilterParams& params, const LidarCalibration& calibration);
 
   // reconstructs and filters every cluster; the accepted ones go to `cones`

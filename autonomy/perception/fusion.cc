@@ -2,23 +2,10 @@
 
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "autonomy/perception/camera_model.h"
 
 namespace paddock::perception {
-
-std::string validate(const FusionParams& p) {
-  std::ostringstream os;
-  if (!std::isfinite(p.camera_range) || !(p.camera_range > 0.0)) {
-    os << "camera_range must be finite and > 0 m (got " << p.camera_range << ")";
-  } else if (!std::isfinite(p.box_margin) || !(p.box_margin >= 0.0)) {
-    os << "box_margin must be finite and >= 0 px (got " << p.box_margin << ")";
-  } else if (!std::isfinite(p.height_offset)) {
-    os << "height_offset must be finite (got " << p.height_offset << ")";
-  }
-  return os.str();
-}
 
 const char* to_string(FusionSource s) {
   switch (s) {

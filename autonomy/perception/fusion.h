@@ -25,26 +25,29 @@
 
 #include <Eigen/Core>
 
+#include "autonomy/common/params.h"
 #include "autonomy/perception/types.h"
 
 namespace paddock::perception {
 
 struct FusionParams {
-  // beyond this range from the camera (m) the detector is not trusted (at the
-  // default detector, detector.h, a cone is missed 9 % of the time at 15 m
-  // and 43 % at 20 m: each miss would drop a real cone) and the point counts
-  // as outside the camera's view
-  double camera_range = 15.0;  // m, > 0
-  // a projected centre this close outside a box still counts as inside: the
-  // boxes' jitter (a pixel or two) and the cluster centre's offset from the
-  // cone's axis (a few cm: 1-3 px at 10 m)
-  double box_margin = 3.0;  // px, >= 0
-  // added to the candidate centre's z before projecting (see the top)
-  double height_offset = 0.0;  // m
-};
+  // at the default detector (detector.h) a cone is missed 9 % of the time at
+  // 15 m and 43 % at 20 m: each miss would drop a real cone
+  double camera_range = 15.0;
+  // the boxes' jitter (a pixel or two) and the cluster centre's offset from
+  // the cone's axis (a few cm: 1-3 px at 10 m)
+  double box_margin = 3.0;
+  // see the top
+  double height_offset = 0.0;
 
-// "" when every field is usable, else the first problem
-std::string validate(const FusionParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(camera_range), {"m", params::in(0.1, 200.0),
+                                    "beyond this the camera is not trusted (LiDAR only): the point counts as outside the camera's view"});
+    v(PADDOCK_PARAM(box_margin), {"px", params::in(0.0, 100.0), "a projected centre this far outside a box is in it"});
+    v(PADDOCK_PARAM(height_offset), {"m", params::any(), "added to the candidate centre's z before projecting"});
+  }
+};
 
 enum class FusionSource {
   Camera,   // in view and in a box: the box's colour

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
-#include <stdexcept>
 
 namespace paddock::perception {
 
@@ -14,51 +12,24 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 }  // namespace
 
-std::string validate(const GroundSegmentationParams& p) {
-  std::ostringstream os;
-  if (!finite(p.max_slope) || !(p.max_slope > 0.0)) {
-    os << "max_slope must be finite and > 0 (got " << p.max_slope << ")";
-  } else if (!finite(p.gap_noise) || !(p.gap_noise >= 0.0)) {
-    os << "gap_noise must be finite and >= 0 m (got " << p.gap_noise << ")";
-  } else if (!finite(p.vertical_threshold) || !(p.vertical_threshold > 0.0)) {
-    os << "vertical_threshold must be finite and > 0 m (got " << p.vertical_threshold << ")";
-  } else if (p.region_bounds.size() > 1000) {
-    os << "region_bounds must hold at most 1000 ranges (got " << p.region_bounds.size() << ")";
-  } else if (p.sectors < 1 || p.sectors > 4096) {
-    os << "sectors must be in [1, 4096] (got " << p.sectors << ")";
-  } else if (!finite(p.ground_threshold) || !(p.ground_threshold > 0.0)) {
-    os << "ground_threshold must be finite and > 0 m (got " << p.ground_threshold << ")";
-  } else if (!finite(p.fit_window) || !(p.fit_window >= p.ground_threshold)) {
-    os << "fit_window must be finite and >= ground_threshold m (got " << p.fit_window << ")";
-  } else if (!finite(p.first_fit_window) || !(p.first_fit_window >= p.ground_threshold)) {
-    os << "first_fit_window must be finite and >= ground_threshold m (got " << p.first_fit_window << ")";
-  } else if (p.fit_iterations < 1 || p.fit_iterations > 100) {
-    os << "fit_iterations must be in [1, 100] (got " << p.fit_iterations << ")";
-  } else if (p.min_fit_points < 3) {
-    os << "min_fit_points must be >= 3 (got " << p.min_fit_points << ")";
-  } else if (!finite(p.slope_prior_spread) || !(p.slope_prior_spread > 0.0)) {
-    os << "slope_prior_spread must be finite and > 0 m (got " << p.slope_prior_spread << ")";
-  } else if (!finite(p.first_slope_prior_spread) || !(p.first_slope_prior_spread > 0.0)) {
-    os << "first_slope_prior_spread must be finite and > 0 m (got " << p.first_slope_prior_spread << ")";
-  } else if (!finite(p.max_step) || !(p.max_step > 0.0)) {
-    os << "max_step must be finite and > 0 m (got " << p.max_step << ")";
-  } else {
-    for (std::size_t i = 0; i < p.region_bounds.size(); ++i) {
-      const double b = p.region_bounds[i];
-      if (!finite(b) || !(b > 0.0) || (i > 0 && !(b > p.region_bounds[i - 1]))) {
-        os << "region_bounds must be finite, > 0 m and ascending (got " << b << " at " << i << ")";
-        break;
-      }
-    }
+std::string GroundSegmentationParams::check() const {
+  if (fit_window < ground_threshold) return "fit_window must be >= ground_threshold";
+  if (first_fit_window < ground_threshold) return "first_fit_window must be >= ground_threshold";
+  if (region_bounds.size() > 1000)
+    return "region_bounds must hold at most 1000 ranges (got " + std::to_string(region_bounds.size()) + ")";
+  for (std::size_t i = 0; i < region_bounds.size(); ++i) {
+    const double b = region_bounds[i];
+    if (!std::isfinite(b) || !(b > 0.0) || (i > 0 && !(b > region_bounds[i - 1])))
+      return "region_bounds must be finite, > 0 m and ascending (got " + params::number(b) + " at " +
+             std::to_string(i) + ")";
   }
-  return os.str();
+  return "";
 }
 
 GroundSegmenter::GroundSegmenter(const GroundSegmentationParams& params,
                                  const LidarCalibration& calibration)
     : params_(params), calib_(calibration), rings_(params.region_bounds.size() + 1) {
-  std::string err = validate(params_);
-  if (!err.empty()) throw std::invalid_argument("GroundSegmentationParams: " + err);
+  params::require_valid(params_, "GroundSegmentationParams");
   params::require_valid(calib_, "LidarCalibration");
 }
 

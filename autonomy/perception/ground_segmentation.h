@@ -44,51 +44,48 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/common/params.h"
 #include "autonomy/perception/motion_correction.h"
 #include "autonomy/perception/types.h"
 
 namespace paddock::perception {
 
 struct GroundSegmentationParams {
-  // the steepest ground (dz / dr): FS tracks are nearly flat; 0.25 (14 deg)
-  // covers a 10 % slope with 0.1 m bumps on a 10 m wavelength (up to ~0.19)
-  double max_slope = 0.25;  // -, > 0
-  // added to the expected gap: two returns' horizontal ranges differ by
-  // noise too (range noise sigma 2 cm: 2.8 cm on a difference). It matters
-  // for this low sensor, whose 0.5 deg rings expect only 1 - 2 cm on the
-  // steepest ground beyond 2 m, no more than a cone's own slope and noise put
-  // between two rings
-  double gap_noise = 0.06;  // m, >= 0
-  // a run of close returns rising by more than this is a vertical object: a
-  // small cone at 10 m still takes three 0.5 deg rings, 0.17 m from the
+  // FS tracks are nearly flat; 0.25 (14 deg) covers a 10 % slope with 0.1 m
+  // bumps on a 10 m wavelength (up to ~0.19)
+  double max_slope = 0.25;
+  // two returns' horizontal ranges differ by noise too (range noise sigma
+  // 2 cm: 2.8 cm on a difference). It matters for this low sensor, whose
+  // 0.5 deg rings expect only 1 - 2 cm on the steepest ground beyond 2 m, no
+  // more than a cone's own slope and noise put between two rings
+  double gap_noise = 0.06;
+  // a small cone at 10 m still takes three 0.5 deg rings, 0.17 m from the
   // lowest to the highest; the ground's range noise moves near returns by
   // millimetres in height
-  double vertical_threshold = 0.05;  // m, > 0
-  // region boundaries (ascending ranges from the sensor): the ground's rings
-  // of a 0.15 m high sensor (-8 .. -0.5 deg, 0.5 deg apart) lie at 1.07 ..
-  // 1.91 m (eight rings), 2.1, 2.5, 2.9, 3.4, 4.3, 5.7, 8.6 and 17.2 m;
+  double vertical_threshold = 0.05;
+  // region boundaries (m, ascending ranges from the sensor, each > 0, at most
+  // 1000 of them; a list, so not visited: check() checks it): the ground's
+  // rings of a 0.15 m high sensor (-8 .. -0.5 deg, 0.5 deg apart) lie at 1.07
+  // .. 1.91 m (eight rings), 2.1, 2.5, 2.9, 3.4, 4.3, 5.7, 8.6 and 17.2 m;
   // beyond that only uphill ground returns
-  std::vector<double> region_bounds{2.0, 4.0, 6.0, 9.0, 13.0, 20.0};  // m
-  // azimuth sectors: 32 make a region about 1.7 m wide at 8.6 m, narrow
-  // enough for 0.1 m bumps of a 10 m wavelength
-  int sectors = 32;  // -, >= 1
-  // a point less than this above its region's plane is ground: bumps leave
-  // ~2-3 cm of residual, a cone's lowest returns below this are added back
-  // by the cone reconstruction
-  double ground_threshold = 0.05;  // m, > 0
-  // the first fit takes candidates within this of the prior plane: below
-  // the 0.15 m at which the ring level with the sensor hits every cone
-  double fit_window = 0.1;  // m, >= ground_threshold
-  // the innermost region's first window: its prior, the level ground under
-  // the car, holds at the sensor only, and the lowest ring meets the ground
-  // ~1.1 m away, where a 10 % slope with bumps (up to ~0.16) already lifts
-  // it 0.17 m
-  double first_fit_window = 0.25;  // m, >= ground_threshold
-  int fit_iterations = 3;    // -, >= 1
-  // fewer candidates than this: the region takes the prior plane. A ground
-  // ring crosses a 32-sector region in 32 columns; a cone gives a region
-  // 2-10 returns off the vertical runs, so a few cones alone cannot make one
-  int min_fit_points = 20;  // -, >= 3
+  std::vector<double> region_bounds{2.0, 4.0, 6.0, 9.0, 13.0, 20.0};
+  // 32 make a region about 1.7 m wide at 8.6 m, narrow enough for 0.1 m
+  // bumps of a 10 m wavelength
+  int sectors = 32;
+  // bumps leave ~2-3 cm of residual, a cone's lowest returns below this are
+  // added back by the cone reconstruction
+  double ground_threshold = 0.05;
+  // below the 0.15 m at which the ring level with the sensor hits every cone
+  double fit_window = 0.1;
+  // the innermost region's prior, the level ground under the car, holds at
+  // the sensor only, and the lowest ring meets the ground ~1.1 m away, where
+  // a 10 % slope with bumps (up to ~0.16) already lifts it 0.17 m
+  double first_fit_window = 0.25;
+  int fit_iterations = 3;
+  // a ground ring crosses a 32-sector region in 32 columns; a cone gives a
+  // region 2-10 returns off the vertical runs, so a few cones alone cannot
+  // make one
+  int min_fit_points = 20;
   // the ridge pulling an unobservable slope toward the prior's (see the
   // top). The innermost region's prior is the level ground under the car,
   // and its returns spread over metres: a weak pull finds a 10 % slope. An
@@ -98,16 +95,29 @@ struct GroundSegmentationParams {
   // ring's region (6 - 9 m) is extrapolated to the -0.5 deg ring at 17 m,
   // where a 0.01 slope error is already 0.09 m of height (0.3 m let cone
   // returns at 7 m tilt it that much, 0.8 m no longer follows 0.1 m bumps)
-  double first_slope_prior_spread = 0.1;  // m, > 0
-  double slope_prior_spread = 0.6;        // m, > 0
-  // a fit whose height differs from the prior's by more than this where it
-  // meets the inner region or at its candidates' centroid is discarded
-  double max_step = 0.08;  // m, > 0
-};
+  double first_slope_prior_spread = 0.1;
+  double slope_prior_spread = 0.6;
+  double max_step = 0.08;
 
-// "" when every field is usable, else the first problem, starting with the
-// field name
-std::string validate(const GroundSegmentationParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(max_slope), {"", params::above(0.0), "the steepest ground (dz / dr)"});
+    v(PADDOCK_PARAM(gap_noise), {"m", params::at_least(0.0), "added to the expected gap between two returns of a column"});
+    v(PADDOCK_PARAM(vertical_threshold), {"m", params::above(0.0), "a run of close returns rising by more than this is a vertical object"});
+    v(PADDOCK_PARAM(sectors), {"", params::in(1, 4096), "azimuth sectors of the regions"});
+    v(PADDOCK_PARAM(ground_threshold), {"m", params::above(0.0), "a point less than this above its region's plane is ground"});
+    v(PADDOCK_PARAM(fit_window), {"m", params::above(0.0),
+                                  "the first fit takes candidates within this of the prior plane (>= ground_threshold)"});
+    v(PADDOCK_PARAM(first_fit_window), {"m", params::above(0.0), "the innermost region's first window (>= ground_threshold)"});
+    v(PADDOCK_PARAM(fit_iterations), {"", params::in(1, 100), "fits per region, the window shrinking to ground_threshold"});
+    v(PADDOCK_PARAM(min_fit_points), {"", params::at_least(3), "a region with fewer candidates takes the prior plane"});
+    v(PADDOCK_PARAM(first_slope_prior_spread), {"m", params::above(0.0), "the innermost region's pull of the slope toward the prior's"});
+    v(PADDOCK_PARAM(slope_prior_spread), {"m", params::above(0.0), "an outer region's pull of the slope toward the prior's"});
+    v(PADDOCK_PARAM(max_step), {"m", params::above(0.0),
+                                "a fit off the prior by more than this where it meets the inner region or at its candidates' centroid is discarded"});
+  }
+  std::string check() const;
+};
 
 struct GroundStats {
   std::size_t ground = 0;
@@ -119,7 +129,8 @@ struct GroundStats {
 
 class GroundSegmenter {
  public:
-  // throws std::invalid_argument when validate(params) or validate(calibration) fails
+  // throws std::invalid_argument when params::validate(params) or
+  // params::validate(calibration) fails
   GroundSegmenter(const GroundSegmentationParams& params, const LidarCalibration& calibration);
 
   // labels every point Ground or NonGround, sets its height and vertical

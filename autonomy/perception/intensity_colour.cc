@@ -2,37 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
-#include <stdexcept>
 
 #include <Eigen/Dense>
 
 namespace paddock::perception {
 
-std::string validate(const IntensityColourParams& p) {
-  std::ostringstream os;
-  if (!finite(p.layer_height) || !(p.layer_height > 0.0)) {
-    os << "layer_height must be finite and > 0 m (got " << p.layer_height << ")";
-  } else if (p.min_layers < 3) {
-    os << "min_layers must be >= 3 (got " << p.min_layers << ")";
-  } else if (!finite(p.min_height)) {
-    os << "min_height must be finite m (got " << p.min_height << ")";
-  } else if (p.min_points < 1) {
-    os << "min_points must be >= 1 (got " << p.min_points << ")";
-  } else if (!finite(p.min_span) || !(p.min_span >= 0.0)) {
-    os << "min_span must be finite and >= 0 m (got " << p.min_span << ")";
-  } else if (!finite(p.min_curvature) || !(p.min_curvature >= 0.0)) {
-    os << "min_curvature must be finite and >= 0 1/m^2 (got " << p.min_curvature << ")";
-  } else if (!finite(p.big_cone_height) || !(p.big_cone_height > 0.0)) {
-    os << "big_cone_height must be finite and > 0 m (got " << p.big_cone_height << ")";
-  }
-  return os.str();
-}
-
 IntensityColourClassifier::IntensityColourClassifier(const IntensityColourParams& params)
     : params_(params) {
-  const std::string err = validate(params_);
-  if (!err.empty()) throw std::invalid_argument("IntensityColourParams: " + err);
+  params::require_valid(params_, "IntensityColourParams");
 }
 
 ConeColor IntensityColourClassifier::classify(const Cloud& cloud, const std::uint32_t* members,

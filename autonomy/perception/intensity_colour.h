@@ -29,37 +29,46 @@
 #include <vector>
 
 #include "autonomy/common/cone.h"
+#include "autonomy/common/params.h"
 #include "autonomy/perception/motion_correction.h"
 
 namespace paddock::perception {
 
 struct IntensityColourParams {
-  // layers: thinner than the small cone's 65 mm stripe, so the stripe owns
-  // a layer of its own when the rings are dense enough
-  double layer_height = 0.03;  // m, > 0
-  int min_layers = 3;          // -, >= 3 (a parabola)
-  // returns lower than this above the ground are left out: the ground
-  // return just in front of a cone joins the cone's vertical run in the
-  // ground segmentation (its gap to the cone's lowest return is within the
-  // expected gap + gap_noise), and its near-zero intensity at the bottom of
-  // a yellow cone would read as a blue cone's dark base. Its height is
-  // ~0 (the ground plane's error, ~1 cm); a cone's lowest ring may hit only
-  // 1 - 2 cm up (a 1 deg layout's -1 deg ring at 7 - 8 m), which 0.02 would
-  // lose
-  double min_height = 0.01;    // m
-  int min_points = 4;          // -, >= 1
-  double min_span = 0.1;       // m, >= 0: from the lowest to the highest layer
-  // |a| below this (normalised intensity per m^2) is no curvature: a stripe
-  // of contrast 0.3 over the cone's 0.3 m bends the parabola by ~10-30
-  double min_curvature = 2.0;  // 1/m^2, >= 0
+  // thinner than the small cone's 65 mm stripe, so the stripe owns a layer
+  // of its own when the rings are dense enough
+  double layer_height = 0.03;
+  // 3: a parabola
+  int min_layers = 3;
+  // the ground return just in front of a cone joins the cone's vertical run
+  // in the ground segmentation (its gap to the cone's lowest return is
+  // within the expected gap + gap_noise), and its near-zero intensity at the
+  // bottom of a yellow cone would read as a blue cone's dark base. Its
+  // height is ~0 (the ground plane's error, ~1 cm); a cone's lowest ring may
+  // hit only 1 - 2 cm up (a 1 deg layout's -1 deg ring at 7 - 8 m), which
+  // 0.02 would lose
+  double min_height = 0.01;
+  int min_points = 4;
+  double min_span = 0.1;
+  // a stripe of contrast 0.3 over the cone's 0.3 m bends the parabola by
+  // ~10-30
+  double min_curvature = 2.0;
   // taller than any small cone (0.325 m), reached by a big one's (0.505 m)
   // returns when a ring hits its upper part
-  double big_cone_height = 0.42;  // m, > 0
-};
+  double big_cone_height = 0.42;
 
-// "" when every field is usable, else the first problem, starting with the
-// field name
-std::string validate(const IntensityColourParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(layer_height), {"m", params::above(0.0), "the returns are cut into layers this thick by their height"});
+    v(PADDOCK_PARAM(min_layers), {"", params::at_least(3), "fewer layers: Unknown"});
+    v(PADDOCK_PARAM(min_height), {"m", params::any(), "returns lower than this above the ground are left out"});
+    v(PADDOCK_PARAM(min_points), {"", params::at_least(1), "fewer returns: Unknown"});
+    v(PADDOCK_PARAM(min_span), {"m", params::at_least(0.0), "layers spanning less height than this (lowest to highest): Unknown"});
+    v(PADDOCK_PARAM(min_curvature), {"1/m^2", params::at_least(0.0),
+                                     "|a| of the normalised intensity parabola below this is no curvature: Unknown"});
+    v(PADDOCK_PARAM(big_cone_height), {"m", params::above(0.0), "a cone whose top return reaches this is BigOrange"});
+  }
+};
 
 // the fit behind a decision, for diagnostics
 struct IntensityProfile {
@@ -69,7 +78,7 @@ struct IntensityProfile {
 
 class IntensityColourClassifier {
  public:
-  // throws std::invalid_argument when validate(params) fails
+  // throws std::invalid_argument when params::validate(params) fails
   explicit IntensityColourClassifier(const IntensityColourParams& params = {});
 
   // the colour of the cone made of cloud.points[members[0 .. n)]; their

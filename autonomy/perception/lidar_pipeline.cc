@@ -1,41 +1,17 @@
 #include "autonomy/perception/lidar_pipeline.h"
 
-#include <sstream>
-#include <stdexcept>
-
 namespace paddock::perception {
 
-std::string validate(const LidarPipelineParams& p) {
-  const auto prefixed = [](const char* stage, const std::string& err) {
-    return err.empty() ? err : std::string(stage) + "." + err;
-  };
-  std::string err = prefixed("calibration", params::validate(p.calibration));
-  if (err.empty()) err = prefixed("ground", validate(p.ground));
-  if (err.empty()) err = prefixed("clustering", params::validate(p.clustering));
-  if (err.empty()) err = prefixed("cone", validate(p.cone));
-  if (err.empty()) err = prefixed("colour", validate(p.colour));
-  if (err.empty() && p.colour.big_cone_height != p.cone.big_cone_height) {
-    std::ostringstream os;
-    os << "colour.big_cone_height must equal cone.big_cone_height (got " << p.colour.big_cone_height
-       << " and " << p.cone.big_cone_height << ")";
-    err = os.str();
-  }
-  return err;
+std::string LidarPipelineParams::check() const {
+  if (const std::string why = params::validate(calibration); !why.empty()) return "calibration." + why;
+  if (colour.big_cone_height != cone.big_cone_height)
+    return "colour.big_cone_height must equal cone.big_cone_height (got " + params::number(colour.big_cone_height) +
+           " and " + params::number(cone.big_cone_height) + ")";
+  return "";
 }
-
-namespace {
-
-// throws before any stage is built when the parameters are unusable
-const LidarPipelineParams& checked(const LidarPipelineParams& p) {
-  const std::string err = validate(p);
-  if (!err.empty()) throw std::invalid_argument("LidarPipelineParams: " + err);
-  return p;
-}
-
-}  // namespace
 
 LidarPipeline::LidarPipeline(const LidarPipelineParams& params)
-    : params_(checked(params)),
+    : params_(params::require_valid(params, "LidarPipelineParams")),
       corrector_(params_.calibration),
       ground_(params_.ground, params_.calibration),
       clusterer_(params_.clustering, params_.calibration),

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
 #include "autonomy/hal/messages.h"
 #include "autonomy/perception/clustering.h"
@@ -32,18 +33,27 @@
 namespace paddock::perception {
 
 struct LidarPipelineParams {
+  // not visited: the runner fills it from the LiDAR's own layout and
+  // mounting ([lidar]); check() checks it
   LidarCalibration calibration;
   GroundSegmentationParams ground;
   ClusteringParams clustering;
   ConeFilterParams cone;
   IntensityColourParams colour;
-  // keep the corrected points with their labels in the result (for plots)
+  // keep the corrected points with their labels in the result (for plots):
+  // not visited, a run-time switch (Perception::set_keep_points)
   bool keep_points = false;
-};
 
-// "" when every field is usable, else the first problem, starting with the
-// field's path (e.g. "ground.max_slope must be ...")
-std::string validate(const LidarPipelineParams& p);
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(ground), "the ground removal (slope-robust cascaded segmentation)");
+    v.section(PADDOCK_PARAM(clustering), "the Euclidean clustering of the non-ground points");
+    v.section(PADDOCK_PARAM(cone), "the cone reconstruction and the rule-based cone filters");
+    v.section(PADDOCK_PARAM(colour), "the cone colour from the LiDAR intensity profile");
+  }
+  // the calibration, then colour.big_cone_height == cone.big_cone_height
+  std::string check() const;
+};
 
 // what each stage did with one scan
 struct LidarCounts {
@@ -85,7 +95,7 @@ struct LidarResult {
 
 class LidarPipeline {
  public:
-  // throws std::invalid_argument when validate(params) fails
+  // throws std::invalid_argument when params::validate(params) fails
   explicit LidarPipeline(const LidarPipelineParams& params = {});
 
   // one rotation; odometry may be null (no motion correction)

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
-#include <stdexcept>
 
 namespace paddock::perception {
 
@@ -14,21 +12,8 @@ double sinc(double h) { return std::abs(h) < 1e-6 ? 1.0 - h * h / 6.0 : std::sin
 
 }  // namespace
 
-std::string validate(const OdometryParams& p) {
-  std::ostringstream os;
-  if (!finite(p.wheel_radius) || !(p.wheel_radius > 0.0)) {
-    os << "wheel_radius must be finite and > 0 m (got " << p.wheel_radius << ")";
-  } else if (!finite(p.history) || !(p.history > 0.0)) {
-    os << "history must be finite and > 0 s (got " << p.history << ")";
-  } else if (!finite(p.extrapolation) || !(p.extrapolation >= 0.0)) {
-    os << "extrapolation must be finite and >= 0 s (got " << p.extrapolation << ")";
-  }
-  return os.str();
-}
-
 Odometry::Odometry(const OdometryParams& params) : params_(params) {
-  const std::string err = validate(params_);
-  if (!err.empty()) throw std::invalid_argument("OdometryParams: " + err);
+  params::require_valid(params_, "OdometryParams");
 }
 
 void Odometry::add(const hal::Imu& imu) {

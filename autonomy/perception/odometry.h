@@ -22,38 +22,46 @@
 // is the arc from the earlier one.
 //
 // No I/O, no clock, no global state.
+#include <cmath>
 #include <cstddef>
 #include <deque>
 #include <optional>
 #include <string>
 
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
 #include "autonomy/hal/messages.h"
 
 namespace paddock::perception {
 
 struct OdometryParams {
-  // dynamic rolling radius of the rear wheels: the default vehicle's
-  // (scenarios/vehicles/default.ini, FSSIM r_dyn)
-  double wheel_radius = 0.231;  // m, > 0
-  // how far back the history reaches behind the newest message: a LiDAR
-  // rotation (0.1 s) plus the scan's latency, with room to spare
-  double history = 2.0;  // s, > 0
-  // how far relative() may extrapolate before the first or after the last
-  // message with the held speed and yaw rate: the wheel speeds come every
-  // 10 ms and the IMU every 5 ms, so a scan that ends between two messages
-  // is always covered by 25 ms
-  double extrapolation = 0.025;  // s, >= 0
-};
+  // dynamic rolling radius of the rear wheels (m): not a parameter of its
+  // own, the runner fills it from the vehicle's ([vehicle] wheel_radius);
+  // the default is the default vehicle's (scenarios/vehicles/default.ini,
+  // FSSIM r_dyn)
+  double wheel_radius = 0.231;
+  // a LiDAR rotation (0.1 s) plus the scan's latency, with room to spare
+  double history = 2.0;
+  // the wheel speeds come every 10 ms and the IMU every 5 ms, so a scan
+  // that ends between two messages is always covered by 25 ms
+  double extrapolation = 0.025;
 
-// "" when every field is usable, else the first problem, starting with the
-// field name
-std::string validate(const OdometryParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(history), {"s", params::above(0.0), "how far back the history reaches behind the newest message"});
+    v(PADDOCK_PARAM(extrapolation), {"s", params::at_least(0.0),
+                                     "how far relative() may extrapolate before the first or after the last message with the held speed and yaw rate"});
+  }
+  std::string check() const {
+    if (std::isfinite(wheel_radius) && wheel_radius > 0.0) return "";
+    return "wheel_radius must be > 0 m (got " + params::number(wheel_radius) + ")";
+  }
+};
 
 class Odometry {
  public:
-  // throws std::invalid_argument when validate(params) fails
+  // throws std::invalid_argument when params::validate(params) fails
   explicit Odometry(const OdometryParams& params = {});
 
   // a message whose values are not finite, or whose stamp lies before the

@@ -2,35 +2,26 @@
 
 #include <cmath>
 #include <string>
-#include <stdexcept>
 #include <utility>
 
 namespace paddock::perception {
 
-std::string validate(const PerceptionParams& p) {
-  if (std::string why = validate(p.odometry); !why.empty()) return "odometry." + why;
-  if (std::string why = validate(p.lidar); !why.empty()) return "lidar." + why;
-  if (std::string why = validate(p.fusion); !why.empty()) return "fusion." + why;
-  if (p.use_camera) {
-    const CameraCalibration& c = p.camera;
-    if (c.width <= 0 || c.height <= 0) return "camera: width and height must be > 0";
-    if (!(c.fx > 0.0) || !(c.fy > 0.0)) return "camera: fx and fy must be > 0";
+std::string PerceptionParams::check() const {
+  if (use_camera) {
+    const CameraCalibration& c = camera;
+    if (c.width <= 0 || c.height <= 0) return "camera.width and camera.height must be > 0 px";
+    if (!(c.fx > 0.0) || !(c.fy > 0.0)) return "camera.fx and camera.fy must be > 0 px";
     if (!std::isfinite(c.cx) || !std::isfinite(c.cy) || !c.T_camera_base.matrix().allFinite())
-      return "camera: cx, cy and T_camera_base must be finite";
+      return "camera.cx, camera.cy and camera.T_camera_base must be finite";
   }
-  if (!(p.camera_sync_tolerance >= 0.0)) return "camera_sync_tolerance must be >= 0";
   return "";
 }
 
-namespace {
-const PerceptionParams& checked(const PerceptionParams& p) {
-  if (std::string why = validate(p); !why.empty()) throw std::invalid_argument("PerceptionParams: " + why);
-  return p;
-}
-}  // namespace
-
 Perception::Perception(const PerceptionParams& params, std::unique_ptr<ConeDetector> detector)
-    : params_(checked(params)), odometry_(params.odometry), pipeline_(params.lidar), detector_(std::move(detector)) {}
+    : params_(params::require_valid(params, "PerceptionParams")),
+      odometry_(params.odometry),
+      pipeline_(params.lidar),
+      detector_(std::move(detector)) {}
 
 void Perception::add(hal::CameraDetections detections) { camera_ = CameraInput{std::move(detections), ""}; }
 

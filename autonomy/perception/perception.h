@@ -24,6 +24,7 @@
 #include <optional>
 #include <string>
 
+#include "autonomy/common/params.h"
 #include "autonomy/hal/messages.h"
 #include "autonomy/perception/detector.h"
 #include "autonomy/perception/fusion.h"
@@ -34,18 +35,31 @@
 namespace paddock::perception {
 
 struct PerceptionParams {
+  // not visited: the stack sets it from the perception mode ([autonomy]
+  // perception: lidar_camera uses the camera, lidar not)
   bool use_camera = true;
   OdometryParams odometry;
-  LidarPipelineParams lidar;  // its calibration: the LiDAR's mounting and beams
-  CameraCalibration camera;   // K and T_camera_base
+  // its calibration: the LiDAR's mounting and beams
+  LidarPipelineParams lidar;
+  // K and T_camera_base; not visited: the runner fills it from the camera's
+  // model and mounting ([camera]); check() checks it when use_camera
+  CameraCalibration camera;
   FusionParams fusion;
   // a camera frame's detections serve the scan during whose rotation the
-  // frame was exposed, give or take this much (s)
+  // frame was exposed, give or take this much
   double camera_sync_tolerance = 0.02;
-};
 
-// "" when every field is usable, else the first problem ("lidar.…", "camera.…")
-std::string validate(const PerceptionParams& p);
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(odometry), "the dead reckoning that motion-corrects the scans");
+    v.section(PADDOCK_PARAM(lidar), "the LiDAR pipeline");
+    v.section(PADDOCK_PARAM(fusion), "the LiDAR-camera fusion");
+    v(PADDOCK_PARAM(camera_sync_tolerance), {"s", params::in(0.0, 1.0),
+                                             "a camera frame serves the rotation it was exposed in, give or take this"});
+  }
+  // the camera's calibration when use_camera
+  std::string check() const;
+};
 
 // what the last scan went through, for plots and diagnostics
 struct PerceptionFrame {
@@ -68,7 +82,7 @@ struct PerceptionStats {
 
 class Perception {
  public:
-  // throws std::invalid_argument when validate(params) fails. detector: a
+  // throws std::invalid_argument when params::validate(params) fails. detector: a
   // network run on the camera frames (add(CameraFrame)), or none when a
   // detector node posts its boxes (add(CameraDetections))
   explicit Perception(const PerceptionParams& params, std::unique_ptr<ConeDetector> detector = nullptr);

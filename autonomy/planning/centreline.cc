@@ -50,8 +50,8 @@ struct Candidate {
 };
 
 // the few edges of the branch being looked ahead (depth <= kMaxDepth)
-constexpr int kMaxDepth = 8;
-constexpr int kMaxBeam = 16;
+constexpr int kMaxDepth = CentrelineParams::kMaxDepth;
+constexpr int kMaxBeam = CentrelineParams::kMaxBeam;
 struct Branch {
   std::array<std::size_t, kMaxDepth> edges{};
   int size = 0;
@@ -476,12 +476,6 @@ class Search {
   const std::vector<Vec2>* arrival_ = nullptr;
 };
 
-bool all_finite_nonneg(std::initializer_list<double> v) {
-  for (double x : v)
-    if (!(finite(x) && x >= 0.0)) return false;
-  return true;
-}
-
 }  // namespace
 
 double track_width_reward(double w, const CentrelineParams& p) {
@@ -496,49 +490,12 @@ double track_width_reward(double w, const CentrelineParams& p) {
   return 1.0;
 }
 
-std::optional<std::string> validate(const CentrelineParams& p) {
-  if (!(finite(p.search_radius) && p.search_radius > 0.0))
-    return "search_radius must be a positive length (m)";
-  if (!(finite(p.min_step) && p.min_step >= 0.0 && p.min_step < p.search_radius))
-    return "min_step must be a length (m) in [0, search_radius)";
-  if (!(finite(p.min_clearance) && p.min_clearance >= 0.0))
-    return "min_clearance must be a length (m) >= 0";
-  if (!(finite(p.max_turn) && p.max_turn > 0.0 && p.max_turn < kPi))
-    return "max_turn must be an angle (rad) in (0, pi)";
-  if (!all_finite_nonneg({p.weight_colour, p.weight_width, p.weight_angle, p.weight_step,
-                          p.weight_prediction, p.weight_crossing}))
-    return "the weights must be finite and >= 0";
-  if (!(p.weight_colour + p.weight_width + p.weight_angle + p.weight_step + p.weight_prediction +
-            p.weight_crossing > 0.0))
-    return "at least one weight must be > 0";
-  if (!(finite(p.width_min) && finite(p.width_max) && p.width_min >= 0.0 &&
-        p.width_min <= p.width_max))
-    return "width_min and width_max must be lengths (m) with width_min <= width_max";
-  if (!(finite(p.colour_radius) && p.colour_radius >= 0.0))
-    return "colour_radius must be a length (m) >= 0";
-  if (!(finite(p.width_sigma) && p.width_sigma > 0.0)) return "width_sigma must be > 0 (m)";
-  if (!(finite(p.angle_sigma) && p.angle_sigma > 0.0)) return "angle_sigma must be > 0 (rad)";
-  if (!(finite(p.step_preferred) && p.step_preferred >= 0.0))
-    return "step_preferred must be a length (m) >= 0";
-  if (!(finite(p.step_sigma) && p.step_sigma > 0.0)) return "step_sigma must be > 0 (m)";
-  if (!(finite(p.prediction_sigma) && p.prediction_sigma > 0.0))
-    return "prediction_sigma must be > 0 (m)";
-  if (p.horizon_depth < 1 || p.horizon_depth > kMaxDepth)
-    return "horizon_depth must be in [1, " + std::to_string(kMaxDepth) + "]";
-  if (p.beam_width < 1 || p.beam_width > kMaxBeam)
-    return "beam_width must be in [1, " + std::to_string(kMaxBeam) + "]";
-  if (p.first_beam_width < 1 || p.first_beam_width > kMaxBeam)
-    return "first_beam_width must be in [1, " + std::to_string(kMaxBeam) + "]";
-  if (!finite(p.min_reward)) return "min_reward must be finite";
-  if (!finite(p.min_horizon_reward)) return "min_horizon_reward must be finite";
-  if (p.max_points < 2) return "max_points must be >= 2";
-  if (!(p.max_length > 0.0)) return "max_length must be > 0 (m)";
-  if (p.closure_points < 1) return "closure_points must be >= 1";
-  if (!(finite(p.closure_min_length) && p.closure_min_length >= 0.0))
-    return "closure_min_length must be a length (m) >= 0";
-  if (!(finite(p.closure_max_angle) && p.closure_max_angle > 0.0 && p.closure_max_angle <= kPi))
-    return "closure_max_angle must be an angle (rad) in (0, pi]";
-  return std::nullopt;
+std::string CentrelineParams::check() const {
+  if (!(min_step < search_radius)) return "min_step must be < search_radius";
+  if (!(weight_colour + weight_width + weight_angle + weight_step + weight_prediction + weight_crossing > 0.0))
+    return "weight_colour, weight_width, weight_angle, weight_step, weight_prediction and weight_crossing must not all be 0";
+  if (!(width_min <= width_max)) return "width_max must be >= width_min";
+  return "";
 }
 
 const char* to_string(CentrelineStatus s) {
@@ -568,9 +525,9 @@ const char* to_string(CentrelineStop s) {
 CentrelineResult search_centreline(const Triangulation& tri, const std::vector<Cone>& cones,
                                    const Pose2& start, const CentrelineParams& params) {
   CentrelineResult out;
-  if (auto bad = validate(params)) {
+  if (const std::string bad = params::validate(params); !bad.empty()) {
     out.status = CentrelineStatus::BadParams;
-    out.reason = "centreline: " + *bad;
+    out.reason = "centreline: " + bad;
     return out;
   }
   if (!(finite(start.x) && finite(start.y) && finite(start.yaw))) {

@@ -6,17 +6,23 @@
 
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 #include "autonomy/common/trajectory.h"
 
 namespace paddock::planning {
 
 struct ClearanceParams {
-  // least distance from a path point to a cone's centre (m): half the car's
-  // width (0.7 m) + a cone's base radius (0.114 m) + the rear axle's
-  // off-tracking in a 4 m hairpin (L^2 / 2R = 0.29 m); 0 switches it off
+  // half the car's width (0.7 m) + a cone's base radius (0.114 m) + the rear
+  // axle's off-tracking in a 4 m hairpin (L^2 / 2R = 0.29 m)
   double clearance = 1.1;
-  // passes over the path (-): a point pushed off one cone may come near another
+  // a point pushed off one cone may come near another
   int iterations = 3;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(clearance), {"m", params::in(0.0, 5.0), "planned path points stay this far from cone centres (0: off)"});
+    v(PADDOCK_PARAM(iterations), {"", params::at_least(0), "passes over the path"});
+  }
 };
 
 // moves each point of `path` that lies closer than the clearance to a cone

@@ -174,25 +174,9 @@ GicpResult fail(GicpResult r, std::string why) {
 
 }  // namespace
 
-std::optional<std::string> validate(const GicpParams& p) {
-  if (p.k_neighbours < 3) return "k_neighbours must be >= 3";
-  if (!(std::isfinite(p.max_correspondence_distance) && p.max_correspondence_distance > 0.0))
-    return "max_correspondence_distance must be a positive length (m)";
-  if (!(std::isfinite(p.refine_correspondence_distance) && p.refine_correspondence_distance >= 0.0))
-    return "refine_correspondence_distance must be >= 0 (m)";
-  if (p.max_iterations < 1) return "max_iterations must be >= 1";
-  if (!(std::isfinite(p.translation_tolerance) && p.translation_tolerance > 0.0))
-    return "translation_tolerance must be a positive length (m)";
-  if (!(std::isfinite(p.rotation_tolerance) && p.rotation_tolerance > 0.0))
-    return "rotation_tolerance must be a positive angle (rad)";
-  if (!(p.covariance_epsilon > 0.0 && p.covariance_epsilon < 1.0))
-    return "covariance_epsilon must be in (0, 1)";
-  return std::nullopt;
-}
-
 std::vector<Covariance2> estimate_covariances(const std::vector<Vec2>& points,
                                               const GicpParams& params) {
-  if (validate(params) || points.empty()) return {};
+  if (!params::validate(params).empty() || points.empty()) return {};
   for (const Vec2& p : points)
     if (!finite(p)) return {};
   const Index index(points);
@@ -220,7 +204,7 @@ GicpResult align(const std::vector<Vec2>& source, const std::vector<Vec2>& targe
                  const Pose2& initial, const GicpParams& params) {
   GicpResult r;
   r.transform = initial;
-  if (auto bad = validate(params)) return fail(r, "gicp: " + *bad);
+  if (const std::string bad = params::validate(params); !bad.empty()) return fail(r, "gicp: " + bad);
   if (auto bad = check_cloud(source, "source")) return fail(r, "gicp: " + *bad);
   if (auto bad = check_cloud(target, "target")) return fail(r, "gicp: " + *bad);
   return align(source, estimate_covariances(source, params), target,
@@ -233,7 +217,7 @@ GicpResult align(const std::vector<Vec2>& source, const std::vector<Covariance2>
   GicpResult r;
   r.transform = initial;
   // inputs
-  if (auto bad = validate(params)) return fail(r, "gicp: " + *bad);
+  if (const std::string bad = params::validate(params); !bad.empty()) return fail(r, "gicp: " + bad);
   if (!(std::isfinite(initial.x) && std::isfinite(initial.y) && std::isfinite(initial.yaw)))
     return fail(r, "gicp: the initial transform is not finite");
   if (auto bad = check_cloud(source, "source")) return fail(r, "gicp: " + *bad);
@@ -362,8 +346,8 @@ GicpObjective gicp_objective(const std::vector<Vec2>& source,
                              const std::vector<Covariance2>& target_cov, const Pose2& transform,
                              const GicpParams& params) {
   GicpObjective out;
-  if (auto bad = validate(params)) {
-    out.reason = "gicp: " + *bad;
+  if (const std::string bad = params::validate(params); !bad.empty()) {
+    out.reason = "gicp: " + bad;
     return out;
   }
   if (source.empty() || target.empty() || source_cov.size() != source.size() ||

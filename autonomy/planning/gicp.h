@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 
 namespace paddock::planning {
 
@@ -27,42 +28,45 @@ namespace paddock::planning {
 // only cones within 20 m of the start seen (GicpBasin in
 // tests/planning/gicp_test.cc is a small version of that sweep)
 struct GicpParams {
-  // neighbours (the point itself included) whose spread gives a point's
-  // covariance (count, >= 3). Skidpad cones along a ring are 2.9-4.2 m
-  // apart and the rings 3.3 m apart, so a neighbourhood mixes both rings
-  // whatever k; 4 (a cone, its two ring neighbours, one more) had the
-  // widest convergence basin of 3, 4 and 5.
+  // Skidpad cones along a ring are 2.9-4.2 m apart and the rings 3.3 m
+  // apart, so a neighbourhood mixes both rings whatever k; 4 (a cone, its two
+  // ring neighbours, one more) had the widest convergence basin of 3, 4 and 5.
   int k_neighbours = 4;
-  // correspondences farther apart than this are ignored (m): wide enough
-  // to pull the template in from a rough start-pose guess (offsets of
-  // 4-7 m at the far cones), and thanks to the plane-to-plane weights a
-  // cone matched to its ring neighbour still pulls along the ring's normal
+  // wide enough to pull the template in from a rough start-pose guess
+  // (offsets of 4-7 m at the far cones), and thanks to the plane-to-plane
+  // weights a cone matched to its ring neighbour still pulls along the
+  // ring's normal
   double max_correspondence_distance = 5.0;
-  // then, once converged, a second stage with correspondences gated at
-  // this (m; 0 = none): a cone with no counterpart (missed, extra) is
-  // matched to a neighbour metres away by the wide gate and drags the fit
-  // along the rings (without it the error was 9 cm / 0.45 deg RMS instead
-  // of 0.6 cm / 0.02 deg); the narrow gate drops it. Between the cone
-  // position noise (cm) and half the cone spacing (~1.5 m).
+  // a cone with no counterpart (missed, extra) is matched to a neighbour
+  // metres away by the wide gate and drags the fit along the rings (without
+  // this stage the error was 9 cm / 0.45 deg RMS instead of 0.6 cm / 0.02
+  // deg); the narrow gate drops it. Between the cone position noise (cm) and
+  // half the cone spacing (~1.5 m).
   double refine_correspondence_distance = 1.0;
-  // outer iterations (correspondences, then one damped Gauss-Newton step)
-  // per stage
   int max_iterations = 100;
-  // converged when a step of the last stage moves less than both of these
-  double translation_tolerance = 1e-4;  // m
-  double rotation_tolerance = 1e-5;     // rad
-  // the variance along the normal relative to 1 along the tangent
-  // (dimensionless, in (0, 1)). The GICP paper's 1e-3 suits dense scans of
-  // surfaces; cones are discrete points whose position along the ring is
-  // information too, and normals from 4 noisy cones are rough: 1e-2 kept
-  // the basin of 1e-3 (better: 291 vs 271 of 300 partial views) and cut the
-  // error at 10 cm cone noise from 3.3 to 2.8 cm; 1 would be point-to-point
-  // ICP (99 of 300).
+  double translation_tolerance = 1e-4;
+  double rotation_tolerance = 1e-5;
+  // The GICP paper's 1e-3 suits dense scans of surfaces; cones are discrete
+  // points whose position along the ring is information too, and normals
+  // from 4 noisy cones are rough: 1e-2 kept the basin of 1e-3 (better: 291
+  // vs 271 of 300 partial views) and cut the error at 10 cm cone noise from
+  // 3.3 to 2.8 cm; 1 would be point-to-point ICP (99 of 300).
   double covariance_epsilon = 1e-2;
-};
 
-// a reason when the parameters cannot be used, or nothing when they can
-std::optional<std::string> validate(const GicpParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(k_neighbours), {"", params::at_least(3), "neighbours (the point itself included) whose spread gives a point's covariance"});
+    v(PADDOCK_PARAM(max_correspondence_distance), {"m", params::above(0.0), "correspondences farther apart than this are ignored"});
+    v(PADDOCK_PARAM(refine_correspondence_distance), {"m", params::at_least(0.0),
+                                                      "once converged, a second stage with correspondences gated at this (0: none)"});
+    v(PADDOCK_PARAM(max_iterations), {"", params::at_least(1),
+                                      "outer iterations (correspondences, then one damped Gauss-Newton step) per stage"});
+    v(PADDOCK_PARAM(translation_tolerance), {"m", params::above(0.0), "converged when a step of the last stage moves less than this ..."});
+    v(PADDOCK_PARAM(rotation_tolerance), {"rad", params::above(0.0), "... and turns less than this"});
+    v(PADDOCK_PARAM(covariance_epsilon), {"", params::Bounds{0.0, 1.0, true, true},
+                                          "the variance along the normal relative to 1 along the tangent"});
+  }
+};
 
 // a symmetric 2x2 covariance [xx xy; xy yy] (m^2)
 struct Covariance2 {

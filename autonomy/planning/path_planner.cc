@@ -19,9 +19,9 @@ constexpr double kSamePoint = 1e-3;
 // False (with out's status and reason set) when there is no centreline.
 bool triangulate_and_search(const std::vector<Cone>& cone_map, const Pose2& vehicle, double speed,
                             const PathPlannerParams& params, PlanResult& out) {
-  if (auto bad = validate(params)) {
+  if (const std::string bad = params::validate(params); !bad.empty()) {
     out.status = PlanStatus::BadParams;
-    out.reason = "planner: " + *bad;
+    out.reason = "planner: " + bad;
     return false;
   }
   if (!finite(vehicle) || std::isnan(speed)) {
@@ -59,13 +59,6 @@ PlanResult with_reference(PlanResult out, ReferenceResult ref) {
 }
 
 }  // namespace
-
-std::optional<std::string> validate(const PathPlannerParams& p) {
-  if (auto bad = validate(p.search)) return "search: " + *bad;
-  if (auto bad = validate(p.smoothing)) return "smoothing: " + *bad;
-  if (auto bad = validate(p.reference)) return "reference: " + *bad;
-  return std::nullopt;
-}
 
 const char* to_string(PlanStatus s) {
   switch (s) {

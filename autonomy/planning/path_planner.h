@@ -11,6 +11,7 @@
 
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 #include "autonomy/common/trajectory.h"
 #include "autonomy/planning/centreline.h"
 #include "autonomy/planning/clearance.h"
@@ -23,16 +24,21 @@ namespace paddock::planning {
 struct PathPlannerParams {
   CentrelineParams search;
   SmoothingParams smoothing;
-  ClearanceParams clearance;  // the smoothed points are pushed clear of the cones
+  ClearanceParams clearance;
   ReferenceParams reference;
-};
 
-// a reason when the parameters cannot be used, or nothing when they can
-std::optional<std::string> validate(const PathPlannerParams& p);
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(search), "the reward-based centreline search");
+    v.section(PADDOCK_PARAM(smoothing), "the centreline's smoothing");
+    v.section(PADDOCK_PARAM(clearance), "the smoothed points are pushed clear of the cones");
+    v.section(PADDOCK_PARAM(reference), "the reference trajectory: spline and velocity profile");
+  }
+};
 
 enum class PlanStatus {
   Ok,
-  BadParams,        // validate() failed
+  BadParams,        // params::validate() failed
   BadInput,         // a non-finite vehicle pose or speed
   NoTriangulation,  // fewer than 3 distinct cones, or all on one line
   NoCentreline,     // the search found no path (see `search` for why)

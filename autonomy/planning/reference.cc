@@ -14,19 +14,11 @@ constexpr double kDuplicateTolerance = 1e-6;
 
 }  // namespace
 
-std::optional<std::string> validate(const ReferenceParams& p) {
-  if (!(std::isfinite(p.knot_spacing) && p.knot_spacing > 0.0))
-    return "knot_spacing must be a positive length (m)";
-  if (!(std::isfinite(p.ds) && p.ds > 0.0)) return "ds must be a positive length (m)";
-  if (auto bad = validate(p.profile)) return "profile: " + *bad;
-  return std::nullopt;
-}
-
 ReferenceResult reference_from_spline(const CubicSpline2D& spline, const ReferenceParams& params,
                                       std::optional<double> v_start, std::optional<double> v_end) {
   ReferenceResult out;
-  if (auto bad = validate(params)) {
-    out.reason = "reference: " + *bad;
+  if (const std::string bad = params::validate(params); !bad.empty()) {
+    out.reason = "reference: " + bad;
     return out;
   }
   if (spline.empty()) {
@@ -75,8 +67,8 @@ ReferenceResult build_reference(const std::vector<Vec2>& centreline, bool closed
                                 const ReferenceParams& params, std::optional<double> v_start,
                                 std::optional<double> v_end) {
   ReferenceResult out;
-  if (auto bad = validate(params)) {
-    out.reason = "reference: " + *bad;
+  if (const std::string bad = params::validate(params); !bad.empty()) {
+    out.reason = "reference: " + bad;
     return out;
   }
   // the centreline: finite, long enough, no point repeated

@@ -14,28 +14,32 @@
 namespace paddock::planning {
 
 struct ReferenceParams {
-  // spacing of the spline knots along the centreline (m). The centreline's
-  // points are joined by a first spline, knots are taken on it this far
-  // apart, and the final spline goes through the knots only: this sets how
-  // much of the centreline's point noise the curve follows (an interpolating
-  // cubic through knots d apart turns a lateral error e at one knot into a
-  // curvature error of order 6 e / d^2). Measured on the FSG 2023 track
-  // (centreline: each blue cone's midpoint with the yellow boundary,
-  // resampled every 0.5 m), the mean |dkappa/ds| of the result is 0.16 1/m^2
-  // at 1 m knots (the curve rings with the cone noise; lap 39.0 s with the
-  // default car), 0.053 at 2 m (30.8 s), 0.025 at 3 m (27.9 s) and 0.020 at
-  // 4 m, where the curve starts to cut the tightest hairpin (centreline
-  // radius ~2.5 m) by 0.3-0.5 m instead of 0.2-0.3 m, and stays >= 1.38 m
-  // from the boundary lines. 3 m is the smallest spacing on that plateau.
+  // knot spacing: the centreline's points are joined by a first spline,
+  // knots are taken on it this far apart, and the final spline goes through
+  // the knots only: this sets how much of the centreline's point noise the
+  // curve follows (an interpolating cubic through knots d apart turns a
+  // lateral error e at one knot into a curvature error of order 6 e / d^2).
+  // Measured on the FSG 2023 track (centreline: each blue cone's midpoint
+  // with the yellow boundary, resampled every 0.5 m), the mean |dkappa/ds|
+  // of the result is 0.16 1/m^2 at 1 m knots (the curve rings with the cone
+  // noise; lap 39.0 s with the default car), 0.053 at 2 m (30.8 s), 0.025 at
+  // 3 m (27.9 s) and 0.020 at 4 m, where the curve starts to cut the
+  // tightest hairpin (centreline radius ~2.5 m) by 0.3-0.5 m instead of
+  // 0.2-0.3 m, and stays >= 1.38 m from the boundary lines. 3 m is the
+  // smallest spacing on that plateau.
   double knot_spacing = 3.0;
-  // arc-length spacing of the trajectory's samples (m); the step used is the
-  // nearest that divides the curve into equal whole steps
+  // the step used is the nearest that divides the curve into equal whole
+  // steps
   double ds = 0.5;
   VelocityProfileParams profile;
-};
 
-// a reason when the parameters cannot be used, or nothing when they can
-std::optional<std::string> validate(const ReferenceParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(knot_spacing), {"m", params::in(0.1, 50.0), "spline knot spacing along the centreline"});
+    v(PADDOCK_PARAM(ds), {"m", params::in(0.01, 10.0), "trajectory sample spacing"});
+    v.section(PADDOCK_PARAM(profile), "the velocity profile: the car's planned limits");
+  }
+};
 
 // a reference trajectory, or the reason why there is none
 struct ReferenceResult {

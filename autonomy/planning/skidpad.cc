@@ -22,29 +22,21 @@ int steps(double length, double spacing) {
 
 }  // namespace
 
-std::optional<std::string> validate(const SkidpadGeometry& g) {
-  const double vals[] = {g.centre_distance, g.inner_diameter, g.outer_diameter, g.cone_offset,
-                         g.exit_end_x,      g.timekeeping_x,  g.timekeeping_y};
-  for (double v : vals)
-    if (!std::isfinite(v)) return "geometry: a value is not finite";
-  if (!(g.centre_distance > 0.0)) return "geometry: centre_distance must be > 0 (m)";
-  if (!(g.cone_offset >= 0.0)) return "geometry: cone_offset must be >= 0 (m)";
-  if (!(g.inner_cone_radius() > 0.0 && g.inner_diameter < g.outer_diameter))
-    return "geometry: need 0 < inner_diameter - 2 cone_offset and inner_diameter < outer_diameter";
-  if (!(g.lane_half_width() > 0.0 && g.outer_cone_radius() > g.centreline_radius()))
-    return "geometry: the centreline circle (radius centre_distance / 2) must run between "
-           "the inner and the outer cones";
-  if (g.cones_per_ring < 4) return "geometry: cones_per_ring must be >= 4";
-  for (double x : g.entry_lane_x)
-    if (!std::isfinite(x)) return "geometry: an entry lane cone is not finite";
-  for (double x : g.exit_lane_x)
-    if (!std::isfinite(x)) return "geometry: an exit lane cone is not finite";
-  if (!(g.exit_end_x > 0.0)) return "geometry: exit_end_x must be > 0 (m)";
-  return std::nullopt;
+std::string SkidpadGeometry::check() const {
+  if (!(inner_cone_radius() > 0.0)) return "inner_diameter must be > 2 cone_offset";
+  if (!(inner_diameter < outer_diameter)) return "outer_diameter must be > inner_diameter";
+  if (!(lane_half_width() > 0.0 && outer_cone_radius() > centreline_radius()))
+    return "centre_distance must put the centreline circle (radius centre_distance / 2) between the inner and "
+           "the outer cones";
+  for (double x : entry_lane_x)
+    if (!std::isfinite(x)) return "entry_lane_x must be finite";
+  for (double x : exit_lane_x)
+    if (!std::isfinite(x)) return "exit_lane_x must be finite";
+  return "";
 }
 
 std::vector<Cone> skidpad_template_cones(const SkidpadGeometry& g) {
-  if (validate(g)) return {};
+  if (!params::validate(g).empty()) return {};
   std::vector<Cone> cones;
   const double rc = g.centreline_radius();
   const double r_in = g.inner_cone_radius();
@@ -86,23 +78,16 @@ std::vector<Cone> skidpad_template_cones(const SkidpadGeometry& g) {
   return cones;
 }
 
-std::optional<std::string> validate(const SkidpadPathParams& p) {
-  if (auto bad = validate(p.geometry)) return bad;
-  const double rc = p.geometry.centreline_radius();
-  if (!(std::isfinite(p.spacing) && p.spacing > 0.0 && p.spacing <= 0.25 * rc))
-    return "spacing must be a length in (0, centreline radius / 4] (m)";
-  if (!(std::isfinite(p.entry_length) && p.entry_length >= 0.0))
-    return "entry_length must be >= 0 (m)";
-  if (!(std::isfinite(p.exit_stop_distance) && p.exit_stop_distance >= 0.0 &&
-        p.exit_stop_distance < p.geometry.exit_end_x))
-    return "exit_stop_distance must be in [0, exit_end_x) (m)";
-  return std::nullopt;
+std::string SkidpadPathParams::check() const {
+  if (!(spacing <= 0.25 * geometry.centreline_radius())) return "spacing must be <= the centreline radius / 4";
+  if (!(exit_stop_distance < geometry.exit_end_x)) return "exit_stop_distance must be < geometry.exit_end_x";
+  return "";
 }
 
 SkidpadPath skidpad_path(const SkidpadPathParams& params) {
   SkidpadPath path;
-  if (auto bad = validate(params)) {
-    path.reason = "skidpad path: " + *bad;
+  if (const std::string bad = params::validate(params); !bad.empty()) {
+    path.reason = "skidpad path: " + bad;
     return path;
   }
   const double rc = params.geometry.centreline_radius();
@@ -141,22 +126,13 @@ SkidpadPath skidpad_path(const SkidpadPathParams& params) {
   return path;
 }
 
-std::optional<std::string> validate(const SkidpadParams& p) {
-  if (auto bad = validate(p.path)) return "path: " + *bad;
-  if (auto bad = validate(p.gicp)) return "gicp: " + *bad;
-  if (auto bad = validate(p.reference)) return "reference: " + *bad;
-  if (p.min_inliers < 3) return "min_inliers must be >= 3";
-  if (!(std::isfinite(p.max_rmse) && p.max_rmse > 0.0)) return "max_rmse must be > 0 (m)";
-  return std::nullopt;
-}
-
 SkidpadPlan plan_skidpad(const std::vector<Cone>& observed_cones, const Pose2& initial_guess,
                          const SkidpadParams& params) {
   SkidpadPlan out;
   out.T_map_template = initial_guess;
   // inputs
-  if (auto bad = validate(params)) {
-    out.reason = "skidpad: " + *bad;
+  if (const std::string bad = params::validate(params); !bad.empty()) {
+    out.reason = "skidpad: " + bad;
     return out;
   }
   if (observed_cones.empty()) {

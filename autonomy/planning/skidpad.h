@@ -14,6 +14,7 @@
 
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 #include "autonomy/common/trajectory.h"
 #include "autonomy/planning/gicp.h"
 #include "autonomy/planning/reference.h"
@@ -22,26 +23,35 @@ namespace paddock::planning {
 
 // the rules' skidpad, as laid out in PacSim's skidpad.yaml (tracks/skidpad.csv)
 struct SkidpadGeometry {
-  // distance between the two circles' centres (m); the centreline radius
-  // is half of it, 9.125 m
+  // the centreline radius is half of it, 9.125 m
   double centre_distance = 18.25;
-  // diameter of the inner and outer boundary lines (m): a 3 m lane
+  // a 3 m lane
   double inner_diameter = 15.25;
   double outer_diameter = 21.25;
-  // cones stand this far outside the lane's boundary lines (m): cone
-  // centres on radii 7.475 and 10.775 m, lane cones 1.65 m off the axis
+  // cone centres on radii 7.475 and 10.775 m, lane cones 1.65 m off the axis
   double cone_offset = 0.15;
-  // cones per full ring (count): one every 22.5 degrees, the first of each
-  // ring on the axis x = 0; the outer rings stop where they meet the lanes
+  // one every 22.5 degrees; the outer rings stop where they meet the lanes
   int cones_per_ring = 16;
-  // small orange lane cones' x (m), on both sides of the axis
+  // small orange lane cones' x (m), on both sides of the axis; lists, so not
+  // visited: check() checks that they are finite
   std::vector<double> entry_lane_x = {-15.0, -11.25};
   std::vector<double> exit_lane_x = {11.0, 16.0, 21.0};
-  // the exit lane is closed by a small orange cone on the axis here (m)
   double exit_end_x = 21.0;
-  // big orange timekeeping cones at (+-x, +-y) (m)
   double timekeeping_x = 1.3;
   double timekeeping_y = 2.0;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(centre_distance), {"m", params::above(0.0), "distance between the two circles' centres"});
+    v(PADDOCK_PARAM(inner_diameter), {"m", params::above(0.0), "diameter of the inner boundary line"});
+    v(PADDOCK_PARAM(outer_diameter), {"m", params::above(0.0), "diameter of the outer boundary line"});
+    v(PADDOCK_PARAM(cone_offset), {"m", params::at_least(0.0), "cones stand this far outside the lane's boundary lines"});
+    v(PADDOCK_PARAM(cones_per_ring), {"", params::at_least(4), "cones per full ring, the first of each ring on the axis x = 0"});
+    v(PADDOCK_PARAM(exit_end_x), {"m", params::above(0.0), "the exit lane is closed by a small orange cone on the axis here"});
+    v(PADDOCK_PARAM(timekeeping_x), {"m", params::any(), "big orange timekeeping cones at (+-x, +-y): x"});
+    v(PADDOCK_PARAM(timekeeping_y), {"m", params::any(), "big orange timekeeping cones at (+-x, +-y): y"});
+  }
+  std::string check() const;
 
   double centreline_radius() const { return 0.5 * centre_distance; }
   double inner_cone_radius() const { return 0.5 * inner_diameter - cone_offset; }
@@ -49,9 +59,6 @@ struct SkidpadGeometry {
   // distance of the lane cones from the axis (m)
   double lane_half_width() const { return centre_distance / 2.0 - inner_cone_radius(); }
 };
-
-// a reason when the geometry cannot be used, or nothing
-std::optional<std::string> validate(const SkidpadGeometry& g);
 
 // the cones the rules place, in the template frame: the right circle
 // (centre (0, -9.125), driven clockwise) has yellow inner and blue outer
@@ -62,20 +69,25 @@ std::vector<Cone> skidpad_template_cones(const SkidpadGeometry& geometry = {});
 
 struct SkidpadPathParams {
   SkidpadGeometry geometry;
-  // spacing of the path's points (m); each piece (the straights and every
-  // lap) is split into equal steps as close to this as fit
+  // each piece (the straights and every lap) is split into equal steps as
+  // close to this as fit
   double spacing = 0.5;
-  // the entry straight starts this far before the crossing (m): behind
-  // where the car starts (x = -16.68 in tracks/skidpad.csv, -16.5 in the
-  // FSSIM layout)
+  // behind where the car starts (x = -16.68 in tracks/skidpad.csv, -16.5 in
+  // the FSSIM layout)
   double entry_length = 18.0;
-  // the exit straight ends this far before the end of the exit lane (m): the
-  // rear axle stops 4 m before the closing cone, the nose ~1.5 m before it
+  // the rear axle stops 4 m before the closing cone, the nose ~1.5 m before it
   double exit_stop_distance = 4.0;
-};
 
-// a reason when the parameters cannot be used, or nothing
-std::optional<std::string> validate(const SkidpadPathParams& p);
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(geometry), "the rules' skidpad layout");
+    v(PADDOCK_PARAM(spacing), {"m", params::above(0.0), "spacing of the path's points (<= the centreline radius / 4)"});
+    v(PADDOCK_PARAM(entry_length), {"m", params::at_least(0.0), "the entry straight starts this far before the crossing"});
+    v(PADDOCK_PARAM(exit_stop_distance), {"m", params::at_least(0.0),
+                                          "the exit straight ends this far before the end of the exit lane (< geometry.exit_end_x)"});
+  }
+  std::string check() const;
+};
 
 // the figure-of-eight path
 struct SkidpadPath {
@@ -98,16 +110,24 @@ SkidpadPath skidpad_path(const SkidpadPathParams& params = {});
 struct SkidpadParams {
   SkidpadPathParams path;
   GicpParams gicp;
+  // not visited: the runner sets it to the planner's ([planning]), so the
+  // skidpad plans with the same limits; check() checks it
   ReferenceParams reference;
-  // the alignment is accepted with at least this many template cones
-  // matched (count) ...
   int min_inliers = 8;
-  // ... at an RMS distance of at most this (m)
   double max_rmse = 0.3;
-};
 
-// a reason when the parameters cannot be used, or nothing
-std::optional<std::string> validate(const SkidpadParams& p);
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(path), "the figure-of-eight path in the template frame");
+    v.section(PADDOCK_PARAM(gicp), "the alignment of the template cones to the observed cones");
+    v(PADDOCK_PARAM(min_inliers), {"", params::at_least(3), "the alignment is accepted with at least this many template cones matched ..."});
+    v(PADDOCK_PARAM(max_rmse), {"m", params::above(0.0), "... at an RMS distance of at most this"});
+  }
+  std::string check() const {
+    const std::string why = params::validate(reference);
+    return why.empty() ? "" : "reference." + why;
+  }
+};
 
 struct SkidpadPlan {
   Trajectory trajectory;  // map frame; empty on failure

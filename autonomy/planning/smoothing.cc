@@ -138,34 +138,21 @@ std::vector<Vec2> opheim(const std::vector<Vec2>& pts, double min_tol, double ma
   return out;
 }
 
-std::optional<std::string> validate(const SmoothingParams& p) {
-  switch (p.method) {
-    case SmoothingParams::Raw:
-    case SmoothingParams::MovingAverage:
-    case SmoothingParams::Opheim:
-    case SmoothingParams::Combined:
-      break;
-    default:
-      return "smoothing: unknown method";
-  }
-  const bool uses_average =
-      p.method == SmoothingParams::MovingAverage || p.method == SmoothingParams::Combined;
-  const bool uses_opheim =
-      p.method == SmoothingParams::Opheim || p.method == SmoothingParams::Combined;
-  if (uses_average && (p.window < 1 || p.window % 2 == 0))
-    return "smoothing: window must be odd and >= 1, got " + std::to_string(p.window);
-  if (uses_opheim && !(std::isfinite(p.opheim_min_tol) && p.opheim_min_tol > 0.0))
-    return "smoothing: opheim_min_tol must be finite and > 0 m, got " +
-           std::to_string(p.opheim_min_tol);
-  if (uses_opheim && !(p.opheim_max_tol > 0.0))
-    return "smoothing: opheim_max_tol must be > 0 m (may be infinite), got " +
-           std::to_string(p.opheim_max_tol);
-  return std::nullopt;
+std::string SmoothingParams::check() const {
+  const bool uses_average = method == MovingAverage || method == Combined;
+  const bool uses_opheim = method == Opheim || method == Combined;
+  if (uses_average && (window < 1 || window % 2 == 0))
+    return "window must be odd and >= 1 when the method averages (got " + std::to_string(window) + ")";
+  if (uses_opheim && !(opheim_min_tol > 0.0))
+    return "opheim_min_tol must be > 0 m when the method uses Opheim (got " + params::number(opheim_min_tol) + ")";
+  if (uses_opheim && !(opheim_max_tol > 0.0))
+    return "opheim_max_tol must be > 0 m when the method uses Opheim (got " + params::number(opheim_max_tol) + ")";
+  return "";
 }
 
 std::vector<Vec2> smooth_centreline(const std::vector<Vec2>& pts, bool closed,
                                     const SmoothingParams& params) {
-  if (validate(params) || pts.size() < 3 || !all_finite(pts)) return pts;
+  if (!params::validate(params).empty() || pts.size() < 3 || !all_finite(pts)) return pts;
   switch (params.method) {
     case SmoothingParams::MovingAverage:
       return moving_average(pts, params.window, closed);

@@ -5,13 +5,14 @@
 //
 // Bad input never throws: an unusable window, tolerance or a non-finite
 // value gives the input back unchanged (all indices, for Opheim), as each
-// function documents; validate() names the reason for a parameter set.
+// function documents; params::validate() names the reason for a parameter
+// set.
 #include <cstddef>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 
 namespace paddock::planning {
 
@@ -76,6 +77,8 @@ std::vector<Vec2> opheim(const std::vector<Vec2>& pts, double min_tol, double ma
 
 struct SmoothingParams {
   enum Method { Raw, MovingAverage, Opheim, Combined };
+  static constexpr params::Choice<Method> kMethodNames[] = {
+      {"combined", Combined}, {"moving_average", MovingAverage}, {"opheim", Opheim}, {"raw", Raw}};
   // Combined = moving average, then Opheim on the averaged points (the
   // paper's best row in Table II)
   Method method = Combined;
@@ -91,32 +94,39 @@ struct SmoothingParams {
   //   Opheim 0.15/5       15.0         0.027        0.37        1.37
   //   Combined 3,0.15/5    8.4         0.018        0.14        1.36  (131 of 194 points)
   //
-  // moving-average window (points, odd). 3 removes most of the zig-zag of
-  // the midpoints. 5 and wider cut the hairpins: averaging points on an arc
-  // pulls them towards its centre by about R (1 - mean cos), which at a
-  // ~2.5 m hairpin with 1.6 m spacing shrinks the radius (peak curvature up,
-  // not down) and moves the line 0.4-0.8 m towards the inner cones.
+  // window: 3 removes most of the zig-zag of the midpoints. 5 and wider cut
+  // the hairpins: averaging points on an arc pulls them towards its centre
+  // by about R (1 - mean cos), which at a ~2.5 m hairpin with 1.6 m spacing
+  // shrinks the radius (peak curvature up, not down) and moves the line
+  // 0.4-0.8 m towards the inner cones.
   int window = 3;
-  // Opheim radial and perpendicular tolerance (m): 0.1-0.3 m behave alike
-  // on these tracks (a third to a half of the averaged points dropped, the
-  // curvature variation a little lower still); 0.15 m is the best on FSG
-  // 2023 and below the ~0.2 m by which the midpoints already scatter about
-  // the true centreline.
+  // 0.1-0.3 m behave alike on these tracks (a third to a half of the
+  // averaged points dropped, the curvature variation a little lower still);
+  // 0.15 m is the best on FSG 2023 and below the ~0.2 m by which the
+  // midpoints already scatter about the true centreline.
   double opheim_min_tol = 0.15;
-  // Opheim search radius (m): consecutive kept points are at most about this
-  // far apart (unless the input's own points are farther), so straights keep
-  // knots for the spline; 8 m let the line drift up to 0.3 m off the
-  // centreline on FSE 2023 (0.14 m at 5 m).
+  // consecutive kept points are at most about this far apart (unless the
+  // input's own points are farther), so straights keep knots for the
+  // spline; 8 m let the line drift up to 0.3 m off the centreline on FSE
+  // 2023 (0.14 m at 5 m).
   double opheim_max_tol = 5.0;
-};
 
-// a reason when the parameters cannot be used, or nothing when they can
-std::optional<std::string> validate(const SmoothingParams& p);
+  // a parameter the method does not use is not checked: the rules that need
+  // the method are in check()
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(method), kMethodNames, "centreline smoothing");
+    v(PADDOCK_PARAM(window), {"", params::any(), "moving-average window (points, odd, >= 1)"});
+    v(PADDOCK_PARAM(opheim_min_tol), {"m", params::any(), "Opheim radial and perpendicular tolerance (> 0)"});
+    v(PADDOCK_PARAM(opheim_max_tol), {"m", params::any(), "Opheim largest step: the search radius around the key (> 0)"});
+  }
+  std::string check() const;
+};
 
 // the centreline smoothed by the chosen method.
 //   pts     centreline points in driving order (m); closed: a lap, the
 //           first point not repeated at the end
-// Raw returns pts. Bad parameters (see validate), fewer than 3 points or a
+// Raw returns pts. Bad parameters (see params::validate), fewer than 3 points or a
 // non-finite coordinate return pts unchanged.
 std::vector<Vec2> smooth_centreline(const std::vector<Vec2>& pts, bool closed,
                                     const SmoothingParams& params = {});

@@ -86,21 +86,11 @@ double available_deceleration(double v, double kappa, const VelocityProfileParam
   return tyre_longitudinal(p.ax_brake_max, v, kappa, p) + drag_decel(v, p);
 }
 
-std::optional<std::string> validate(const VelocityProfileParams& p) {
-  auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
-  if (!positive(p.ax_max)) return "ax_max must be a positive acceleration (m/s^2)";
-  if (!positive(p.ay_max)) return "ay_max must be a positive acceleration (m/s^2)";
-  if (!positive(p.ax_brake_max)) return "ax_brake_max must be a positive deceleration (m/s^2)";
-  if (!positive(p.ax_machine)) return "ax_machine must be a positive acceleration (m/s^2)";
-  // the reference recommends [1, 2]; any p >= 1 is a convex g-g shape
-  if (!(std::isfinite(p.exponent) && p.exponent >= 1.0)) return "exponent must be >= 1";
-  if (!positive(p.mass)) return "mass must be positive (kg)";
-  if (!(std::isfinite(p.drag_coefficient) && p.drag_coefficient >= 0.0))
-    return "drag_coefficient must be >= 0 (N s^2/m^2)";
-  if (!positive(p.v_max)) return "v_max must be a positive finite speed (m/s)";
-  if (!(std::isfinite(p.turn_accel_scale) && p.turn_accel_scale >= 0.0 && p.turn_accel_scale <= 1.0))
-    return "turn_accel_scale must be in [0, 1]";
-  return std::nullopt;
+std::string VelocityProfileParams::check() const {
+  if (!(std::isfinite(mass) && mass > 0.0)) return "mass must be > 0 kg (got " + params::number(mass) + ")";
+  if (!(std::isfinite(drag_coefficient) && drag_coefficient >= 0.0))
+    return "drag_coefficient must be >= 0 N s^2/m^2 (got " + params::number(drag_coefficient) + ")";
+  return "";
 }
 
 VelocityProfile solve_velocity_profile(const std::vector<double>& curvature,
@@ -138,8 +128,8 @@ VelocityProfile solve_velocity_profile(const std::vector<double>& curvature,
     out.reason = "velocity profile: v_start or v_end is NaN";
     return out;
   }
-  if (auto bad = validate(params)) {
-    out.reason = "velocity profile: " + *bad;
+  if (const std::string bad = params::validate(params); !bad.empty()) {
+    out.reason = "velocity profile: " + bad;
     return out;
   }
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/common/params.h"
+
 namespace paddock::planning {
 
 // the car's g-g limits and longitudinal model for the profile. The defaults
@@ -18,30 +20,32 @@ struct VelocityProfileParams {
   // driverless stack keeps about half of that in reserve for tracking,
   // localisation and perception errors, as the paper's car did (41 s laps on
   // FSG 2023). With these limits the car laps FSG 2023 in about 35 s.
-  // longitudinal acceleration limit (m/s^2): 0.8 g
+  // 0.8 g
   double ax_max = 8.0;
-  // lateral acceleration limit (m/s^2): 0.8 g, about half the tyres' grip
+  // 0.8 g, about half the tyres' grip
   double ay_max = 8.0;
-  // deceleration limit (m/s^2, positive): 0.8 g
+  // 0.8 g
   double ax_brake_max = 8.0;
-  // exponent p of the g-g shape (ax/ax_max)^p + (ay/ay_max)^p <= 1:
-  // 2 is the friction ellipse, 1 a diamond (conservative); >= 1 (the
+  // the g-g shape (ax/ax_max)^p + (ay/ay_max)^p <= 1: 2 is the friction
+  // ellipse, 1 a diamond (conservative); any p >= 1 is a convex shape (the
   // reference recommends [1, 2]).
   double exponent = 2.0;
-  // machine (motor) acceleration limit without drag (m/s^2), constant in
-  // speed: 5000 N / 190 kg = 26.3 m/s^2 is more than the tyres can transmit,
-  // so it is capped at the traction limit mu g = 1.6 * 9.81 = 15.7 m/s^2;
-  // with ax_max = 8 the planned limit is what shapes the launch.
+  // constant in speed: 5000 N / 190 kg = 26.3 m/s^2 is more than the tyres
+  // can transmit, so it is capped at the traction limit mu g = 1.6 * 9.81 =
+  // 15.7 m/s^2; with ax_max = 8 the planned limit is what shapes the launch.
   double ax_machine = 15.7;
-  // vehicle mass (kg), used only to turn drag force into deceleration.
+  // vehicle mass (kg), used only to turn drag force into deceleration. Not
+  // visited: the runner fills it from the vehicle ([vehicle] mass); check()
+  // checks it
   double mass = 190.0;
   // aerodynamic drag F = c_d v^2 (N s^2/m^2): it slows the car when
-  // accelerating and helps it when braking.
+  // accelerating and helps it when braking. Not visited: the runner fills it
+  // from the vehicle ([vehicle] c_drag); check() checks it
   double drag_coefficient = 0.7;
-  // top speed (m/s): 72 km/h, about what FS trackdrive straights allow.
+  // 72 km/h, about what FS trackdrive straights allow.
   double v_max = 20.0;
-  // the paper's "reduced acceleration limits in turns" (dimensionless, in
-  // [0, 1]; 1 = off). The tyre limits ax_max and ax_brake_max are scaled by
+  // the paper's "reduced acceleration limits in turns" (1 = off). The tyre
+  // limits ax_max and ax_brake_max are scaled by
   //   f = 1 - (1 - turn_accel_scale) * min(1, ay / ay_max),   ay = v^2 |kappa|,
   // before the friction ellipse is applied: on a straight f = 1, and the more
   // of the lateral grip a turn uses, the less of the longitudinal limit is
@@ -50,10 +54,19 @@ struct VelocityProfileParams {
   // Default 0.5: in a turn at the lateral limit, half the straight-line
   // acceleration and braking is planned.
   double turn_accel_scale = 0.5;
-};
 
-// a reason when the parameters cannot be used, or nothing when they can
-std::optional<std::string> validate(const VelocityProfileParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(ax_max), {"m/s^2", params::in(0.1, 100.0), "tyre acceleration limit of the profile"});
+    v(PADDOCK_PARAM(ay_max), {"m/s^2", params::in(0.1, 100.0), "tyre lateral limit of the profile"});
+    v(PADDOCK_PARAM(ax_brake_max), {"m/s^2", params::in(0.1, 100.0), "tyre deceleration limit of the profile"});
+    v(PADDOCK_PARAM(exponent), {"", params::in(1.0, 10.0), "g-g diagram exponent p"});
+    v(PADDOCK_PARAM(ax_machine), {"m/s^2", params::in(0.1, 100.0), "motor acceleration limit"});
+    v(PADDOCK_PARAM(v_max), {"m/s", params::in(0.1, 100.0), "top speed of the profile"});
+    v(PADDOCK_PARAM(turn_accel_scale), {"", params::fraction(), "longitudinal limits kept in a full-grip turn"});
+  }
+  std::string check() const;
+};
 
 // speeds along a path; `reason` says why it failed (empty when ok)
 struct VelocityProfile {

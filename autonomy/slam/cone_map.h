@@ -10,19 +10,26 @@
 
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 
 namespace paddock::slam {
 
 struct ConeMapParams {
-  // a detection farther than this from every mapped cone starts a new one (m):
   // half the smallest cone spacing of a real track (~2 m in a hairpin) keeps
   // neighbours apart while absorbing centimetres of noise
   double association_distance = 1.0;
-  // observations before a cone counts as real (-): a real cone is seen in
-  // most frames while the car approaches it (~20 frames from 20 m at 10 m/s),
-  // a false positive of a good pipeline rarely repeats at one place; over a
-  // 10-lap run at 0.2 ghosts per frame, 2 sightings let dozens of ghosts in
+  // a real cone is seen in most frames while the car approaches it (~20
+  // frames from 20 m at 10 m/s), a false positive of a good pipeline rarely
+  // repeats at one place; over a 10-lap run at 0.2 ghosts per frame, 2
+  // sightings let dozens of ghosts in
   int min_observations = 5;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(association_distance), {"m", params::in(0.01, 10.0),
+                                            "a detection farther from every mapped cone starts a new one"});
+    v(PADDOCK_PARAM(min_observations), {"", params::in(1, 1000), "sightings before a mapped cone counts"});
+  }
 };
 
 struct MappedCone {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
 #include "autonomy/common/trajectory.h"
 #include "autonomy/control/controller.h"
@@ -30,59 +31,106 @@ enum class SlamMode { GroundTruth };
 enum class PlannerMode { Oracle, Delaunay };
 
 struct AutonomyModes {
+  static constexpr params::Choice<PerceptionMode> kPerceptionNames[] = {
+      {"ground_truth", PerceptionMode::GroundTruth}, {"lidar", PerceptionMode::Lidar}, {"lidar_camera", PerceptionMode::LidarCamera}};
+  static constexpr params::Choice<SlamMode> kSlamNames[] = {{"ground_truth", SlamMode::GroundTruth}};
+  static constexpr params::Choice<PlannerMode> kPlannerNames[] = {{"delaunay", PlannerMode::Delaunay},
+                                                                  {"oracle", PlannerMode::Oracle}};
   PerceptionMode perception = PerceptionMode::GroundTruth;
   SlamMode slam = SlamMode::GroundTruth;
   PlannerMode planner = PlannerMode::Delaunay;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(perception), kPerceptionNames, "where the cones come from");
+    v(PADDOCK_PARAM(slam), kSlamNames, "where the pose comes from");
+    v(PADDOCK_PARAM(planner), kPlannerNames, "where the reference path comes from");
+  }
 };
 
 // the dynamic events of the FS rules, as selected on the car's mission switch
 enum class Mission { Acceleration, Skidpad, Autocross, Trackdrive };
 
 struct MissionParams {
-  double stop_decel = 8.0;         // deceleration of the stop after the finish (m/s^2), the planner's braking limit
-  double standstill_speed = 0.05;  // below this the car counts as stopped (m/s)
-  double state_timeout = 0.2;      // a state estimate older than this triggers the safe stop (s)
-  // the least start speed of a planned profile (m/s): a car at rest needs a
-  // reference above zero to start on
+  // the planner's braking limit
+  double stop_decel = 8.0;
+  double standstill_speed = 0.05;
+  double state_timeout = 0.2;
+  // a car at rest needs a reference above zero to start on
   double launch_speed = 2.0;
   // trackdrive: a closed centreline is the lap, planned once and driven from
-  // then on, when the car has driven at least this far (m) and is back within
-  // this distance of where it started (m): then every cone of the lap has been
-  // seen; earlier closures are the search cutting across a map still being explored
+  // then on, when the car has driven at least loop_closure_distance and is
+  // back within loop_closure_radius of where it started: then every cone of
+  // the lap has been seen; earlier closures are the search cutting across a
+  // map still being explored
   double loop_closure_distance = 100.0;
   double loop_closure_radius = 15.0;
-  // the closed lap takes over from the exploration path only where the car
-  // is this close to it (m), so the handover does not jerk the car sideways
+  // so the handover does not jerk the car sideways
   double lap_switch_offset = 0.1;
-  // a timekeeping gate is learned from big orange cones seen at least this
-  // often (-) whose gate's middle lies this close to the planned path (m):
-  // a ghost cone of perception must not become a finish line
+  // a timekeeping gate is learned from big orange cones seen at least
+  // gate_min_observations times whose gate's middle lies within
+  // gate_max_offset of the planned path: a ghost cone of perception must not
+  // become a finish line
   int gate_min_observations = 5;
   double gate_max_offset = 2.0;
-  // gate crossings closer together than this count once (m): a line marked
-  // by two rows of big orange cones is one line
+  // a line marked by two rows of big orange cones is one line
   double gate_refractory_distance = 10.0;
-  // acceleration: the straight is planned this far from the start (m): 75 m
-  // to the finish and the braking zone after it
+  // 75 m to the finish and the braking zone after it
   double acceleration_length = 150.0;
-  // skidpad: the rules' start position, the car's base this far before the
-  // timekeeping line at the crossing (m); the first guess of the alignment
+  // the rules' start position; the first guess of the alignment
   double skidpad_crossing_ahead = 16.5;
-  // skidpad: mapped cones needed before the layout is aligned (-)
   int skidpad_min_cones = 20;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(stop_decel), {"m/s^2", params::in(0.1, 50.0), "deceleration of the stop after the finish"});
+    v(PADDOCK_PARAM(standstill_speed), {"m/s", params::in(0.0, 5.0), "below this the stack counts as stopped"});
+    v(PADDOCK_PARAM(state_timeout), {"s", params::in(0.001, 10.0), "a staler state estimate triggers the safe stop"});
+    v(PADDOCK_PARAM(launch_speed), {"m/s", params::at_least(0.0), "the least start speed of a planned profile"});
+    v(PADDOCK_PARAM(loop_closure_distance), {"m", params::in(0.0, 10000.0), "driving before a closed centreline is the lap"});
+    v(PADDOCK_PARAM(loop_closure_radius), {"m", params::in(0.0, 10000.0),
+                                           "the car must be this close to its start for the lap to be taken (0: anywhere)"});
+    v(PADDOCK_PARAM(lap_switch_offset), {"m", params::in(0.0, 10.0), "the closed lap takes over where the car is this close to it"});
+    v(PADDOCK_PARAM(gate_min_observations), {"", params::at_least(1), "a timekeeping gate is learned from big orange cones seen this often ..."});
+    v(PADDOCK_PARAM(gate_max_offset), {"m", params::at_least(0.0), "... whose gate's middle lies this close to the planned path"});
+    v(PADDOCK_PARAM(gate_refractory_distance), {"m", params::at_least(0.0), "gate crossings closer together than this count once"});
+    v(PADDOCK_PARAM(acceleration_length), {"m", params::above(0.0), "acceleration: the straight is planned this far from the start"});
+    v(PADDOCK_PARAM(skidpad_crossing_ahead), {"m", params::at_least(0.0),
+                                              "skidpad: the car's base starts this far before the timekeeping line at the crossing"});
+    v(PADDOCK_PARAM(skidpad_min_cones), {"", params::at_least(0), "skidpad: mapped cones needed before the layout is aligned"});
+  }
 };
 
 struct StackParams {
   AutonomyModes modes;
   // perception = lidar | lidar_camera (use_camera follows the mode)
   perception::PerceptionParams perception;
-  planning::PathPlannerParams planner;   // its reference params serve the oracle mode too
+  // its reference params serve the oracle mode too
+  planning::PathPlannerParams planner;
   planning::SkidpadParams skidpad;
   control::ControlParams control;
+  // not visited: the runner fills it from the vehicle ([vehicle]); check()
+  // checks it
   control::VehicleKnowledge vehicle;
   MissionParams mission;
   slam::ConeMapParams cone_map;
   GateParams gates;
+
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(modes), "where each layer's input comes from");
+    v.section(PADDOCK_PARAM(perception), "the perception front (perception = lidar | lidar_camera)");
+    v.section(PADDOCK_PARAM(planner), "one planning cycle (planner = delaunay); its reference serves the oracle mode too");
+    v.section(PADDOCK_PARAM(skidpad), "the skidpad's precalculated path and its alignment");
+    v.section(PADDOCK_PARAM(control), "the lateral law and the speed loop");
+    v.section(PADDOCK_PARAM(mission), "the mission logic of each event");
+    v.section(PADDOCK_PARAM(cone_map), "the stack's map of cones");
+    v.section(PADDOCK_PARAM(gates), "timekeeping gates from the big orange cones");
+  }
+  std::string check() const {
+    const std::string why = params::validate(vehicle);
+    return why.empty() ? "" : "vehicle." + why;
+  }
 };
 
 // what the car is told before the start

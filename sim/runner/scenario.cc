@@ -580,9 +580,12 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
     throw UserError(path + ": [sim] physics_rate (" + std::to_string(s.sim.physics_rate) +
                     " Hz) must be a whole multiple of control_rate and log_rate");
   }
-  if (const char* why = control::validate(s.control, stack_params(s).vehicle)) throw UserError(path + ": [control] " + why);
+  if (const std::string why = params::validate(s.control); !why.empty()) throw UserError(path + ": [control] " + why);
+  if (const std::string why = params::validate(stack_params(s).vehicle); !why.empty()) {
+    throw UserError(path + ": [control] vehicle." + why);
+  }
   if (const std::string why = sensors::validate(s.cone_sensor); !why.empty()) throw UserError(path + ": [cone_sensor] " + why);
-  if (const auto why = planning::validate(s.planning)) throw UserError(path + ": [planning] " + *why);
+  if (const std::string why = params::validate(s.planning); !why.empty()) throw UserError(path + ": [planning] " + why);
   if (const std::string why = sensors::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
   if (const std::string why = sensors::validate(s.wheel_speeds); !why.empty()) throw UserError(path + ": [wheel_speeds] " + why);
   if (const std::string why = sensors::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
@@ -590,7 +593,7 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   if (const std::string why = sensors::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
   if (const std::string why = sensors::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
   if (const std::string why = sensors::validate(s.detector); !why.empty()) throw UserError(path + ": [detector] " + why);
-  if (const std::string why = perception::validate(stack_params(s).perception); !why.empty()) {
+  if (const std::string why = params::validate(stack_params(s).perception); !why.empty()) {
     throw UserError(path + ": [perception] " + why);
   }
 

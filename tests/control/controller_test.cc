@@ -70,13 +70,23 @@ ControlParams mode(LateralMode m) {
 const LateralMode kModes[] = {LateralMode::Combined, LateralMode::Stanley, LateralMode::PurePursuit};
 
 TEST(Controller, DefaultsAreValid) {
-  EXPECT_EQ(validate(ControlParams{}, VehicleKnowledge{}), nullptr);
+  EXPECT_EQ(params::validate(ControlParams{}), "");
+  EXPECT_EQ(params::validate(VehicleKnowledge{}), "");
   ControlParams p;
   p.combined.k_max = 0.1;  // below k_min
-  EXPECT_NE(validate(p, VehicleKnowledge{}), nullptr);
+  EXPECT_EQ(params::validate(p), "combined.k_max must be >= k_min");
+  p = ControlParams{};
+  p.stanley.k_soft = 0.0;
+  EXPECT_EQ(params::validate(p), "stanley.k_soft must be in (0, 100] m/s (got 0)");
+  p = ControlParams{};
+  p.lateral = static_cast<LateralMode>(5);
+  EXPECT_EQ(params::validate(p), "lateral has a value that is not one of its names");
   VehicleKnowledge v;
   v.wheelbase = 2.0;  // not lf + lr
-  EXPECT_NE(validate(ControlParams{}, v), nullptr);
+  EXPECT_EQ(params::validate(v), "wheelbase must equal lf + lr (got 2, lf + lr = 1.53)");
+  v = VehicleKnowledge{};
+  v.max_steering_angle = 2.0;
+  EXPECT_EQ(params::validate(v), "max_steering_angle must be in (0, 1.5707963267948966) rad (got 2)");
 }
 
 TEST(Controller, RightOfThePathSteersLeft) {

@@ -555,24 +555,27 @@ TEST(LidarPipelineTest, EmptyAndNanScansGiveACleanStatus) {
 
 TEST(LidarPipelineTest, ValidateNamesTheField) {
   LidarPipelineParams p;
-  EXPECT_EQ(validate(p), "");
+  EXPECT_EQ(params::validate(p), "");
   p.ground.max_slope = -1.0;
-  EXPECT_EQ(validate(p).rfind("ground.max_slope", 0), 0u) << validate(p);
+  EXPECT_EQ(params::validate(p), "ground.max_slope must be > 0 (got -1)");
   p = LidarPipelineParams{};
   p.ground.region_bounds = {3.0, 2.0};
-  EXPECT_EQ(validate(p).rfind("ground.region_bounds", 0), 0u) << validate(p);
+  EXPECT_EQ(params::validate(p), "ground.region_bounds must be finite, > 0 m and ascending (got 2 at 1)");
   p = LidarPipelineParams{};
   p.clustering.tolerance = 0.0;
-  EXPECT_EQ(validate(p).rfind("clustering.tolerance", 0), 0u);
+  EXPECT_EQ(params::validate(p), "clustering.tolerance must be > 0 m (got 0)");
   p = LidarPipelineParams{};
   p.cone.max_count_ratio = 0.1;
-  EXPECT_EQ(validate(p).rfind("cone.max_count_ratio", 0), 0u);
+  EXPECT_EQ(params::validate(p), "cone.max_count_ratio must be > min_count_ratio");
   p = LidarPipelineParams{};
   p.colour.min_layers = 2;
-  EXPECT_EQ(validate(p).rfind("colour.min_layers", 0), 0u);
+  EXPECT_EQ(params::validate(p), "colour.min_layers must be >= 3 (got 2)");
+  p = LidarPipelineParams{};
+  p.colour.big_cone_height = 0.5;
+  EXPECT_EQ(params::validate(p), "colour.big_cone_height must equal cone.big_cone_height (got 0.5 and 0.42)");
   p = LidarPipelineParams{};
   p.calibration.channels = 0;
-  EXPECT_EQ(validate(p).rfind("calibration.channels", 0), 0u);
+  EXPECT_EQ(params::validate(p), "calibration.channels must be in [1, 65535] (got 0)");
   EXPECT_THROW(LidarPipeline{p}, std::invalid_argument);
 }
 

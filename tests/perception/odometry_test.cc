@@ -73,12 +73,12 @@ TEST(OdometryTest, HistoryIsBoundedAndBadMessagesAreIgnored) {
 
 TEST(OdometryTest, ValidateNamesTheField) {
   OdometryParams p;
-  EXPECT_EQ(validate(p), "");
+  EXPECT_EQ(params::validate(p), "");
   p.wheel_radius = -1.0;
-  EXPECT_EQ(validate(p).rfind("wheel_radius", 0), 0u);
+  EXPECT_EQ(params::validate(p), "wheel_radius must be > 0 m (got -1)");
   p = OdometryParams{};
   p.history = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(validate(p).rfind("history", 0), 0u);
+  EXPECT_EQ(params::validate(p), "history must be > 0 s (got nan)");
 }
 
 }  // namespace

@@ -77,22 +77,26 @@ TEST(Centreline, TrackWidthRewardIsThePapersFigure) {
 }
 
 TEST(Centreline, DefaultParametersAreValid) {
-  EXPECT_FALSE(validate(CentrelineParams{}).has_value());
+  EXPECT_EQ(params::validate(CentrelineParams{}), "");
   CentrelineParams p;
   p.weight_width = -1.0;
-  EXPECT_TRUE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "weight_width must be in [0, 100] (got -1)");
   p = {};
   p.width_min = 6.0;  // above width_max
-  EXPECT_TRUE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "width_max must be >= width_min");
   p = {};
   p.horizon_depth = 0;
-  EXPECT_TRUE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "horizon_depth must be in [1, 8] (got 0)");
   p = {};
   p.min_step = p.search_radius + 1.0;
-  EXPECT_TRUE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "min_step must be < search_radius");
   p = {};
   p.min_reward = kNaN;
-  EXPECT_TRUE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "min_reward must be in [-10, 10] (got nan)");
+  p = {};
+  p.weight_colour = p.weight_width = p.weight_angle = p.weight_step = p.weight_prediction = p.weight_crossing = 0.0;
+  EXPECT_EQ(params::validate(p),
+            "weight_colour, weight_width, weight_angle, weight_step, weight_prediction and weight_crossing must not all be 0");
 }
 
 // ---- synthetic tracks ----------------------------------------------------------------

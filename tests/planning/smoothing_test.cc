@@ -495,7 +495,7 @@ TEST(SmoothCentreline, DefaultsSmoothANoisyLapAndStayOnIt) {
   const auto pts = noisy_oval(&truth);
   const SmoothingParams defaults;
   EXPECT_EQ(defaults.method, SmoothingParams::Combined);
-  EXPECT_FALSE(validate(defaults).has_value());
+  EXPECT_EQ(params::validate(defaults), "");
   const auto out = smooth_centreline(pts, true, defaults);
   EXPECT_LT(out.size(), pts.size());
   EXPECT_GE(out.size(), 3u);
@@ -509,26 +509,30 @@ TEST(SmoothCentreline, BadParametersOrInputReturnTheInput) {
   const auto pts = noisy_oval();
   SmoothingParams p;
   p.window = 4;
-  EXPECT_TRUE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "window must be odd and >= 1 when the method averages (got 4)");
   EXPECT_EQ(smooth_centreline(pts, true, p), pts);
   p = SmoothingParams{};
   p.opheim_min_tol = kNaN;
-  EXPECT_TRUE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "opheim_min_tol must be a finite number m (got nan)");
   EXPECT_EQ(smooth_centreline(pts, true, p), pts);
   p = SmoothingParams{};
   p.opheim_max_tol = 0.0;
-  EXPECT_TRUE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "opheim_max_tol must be > 0 m when the method uses Opheim (got 0)");
+  // every number of a parameter set is finite: no limit is a large one
   p.opheim_max_tol = kInf;
-  EXPECT_FALSE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "opheim_max_tol must be a finite number m (got inf)");
+  EXPECT_EQ(smooth_centreline(pts, true, p), pts);
+  p.opheim_max_tol = 1e9;
+  EXPECT_EQ(params::validate(p), "");
   // a method that does not use a parameter does not check it
   p = SmoothingParams{};
   p.method = SmoothingParams::Opheim;
   p.window = 0;
-  EXPECT_FALSE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "");
   p = SmoothingParams{};
   p.method = SmoothingParams::Raw;
   p.opheim_min_tol = -1.0;
-  EXPECT_FALSE(validate(p).has_value());
+  EXPECT_EQ(params::validate(p), "");
 
   const SmoothingParams d;
   for (bool closed : {false, true}) {

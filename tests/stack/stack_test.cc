@@ -8,6 +8,7 @@
 #include <cmath>
 #include <deque>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace paddock::stack {
@@ -265,6 +266,79 @@ TEST(Stack, AGateSeenOnlyAfterTheCarCrossedItCounts) {
   EXPECT_EQ(s.telemetry().finish_crossings, 2);
   EXPECT_TRUE(s.telemetry().stopping);
   EXPECT_EQ(s.gates().size(), 2u);
+}
+
+// the paths a visitor sees in a whole stack's parameters
+struct PathLister {
+  std::vector<std::string> paths;
+  std::string prefix;
+  template <class T>
+  void operator()(const char* key, T&, const params::Spec&) { paths.push_back(prefix + key); }
+  template <class E, std::size_t N>
+  void operator()(const char* key, E&, const params::Choice<E> (&)[N], const char*) { paths.push_back(prefix + key); }
+  void operator()(const char* key, bool&, const char*) { paths.push_back(prefix + key); }
+  template <class P>
+  void section(const char* key, P& p, const char*) {
+    const std::string saved = prefix;
+    prefix += std::string(key) + ".";
+    p.visit(*this);
+    prefix = saved;
+  }
+};
+
+TEST(StackParams, EveryParameterHasOnePathAndWhatTheRunnerFillsHasNone) {
+  StackParams p;
+  PathLister l;
+  p.visit(l);
+  std::vector<std::string> sorted = l.paths;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
+  const auto has = [&](const std::string& path) { return std::count(l.paths.begin(), l.paths.end(), path) == 1; };
+  for (const char* path : {"modes.perception", "modes.slam", "modes.planner", "perception.odometry.history",
+                           "perception.lidar.ground.max_slope", "perception.lidar.clustering.tolerance",
+                           "perception.fusion.camera_range", "perception.camera_sync_tolerance",
+                           "planner.search.search_radius", "planner.smoothing.method", "planner.clearance.clearance",
+                           "planner.reference.profile.v_max", "skidpad.path.geometry.centre_distance",
+                           "skidpad.gicp.k_neighbours", "skidpad.max_rmse", "control.lateral",
+                           "control.stanley.use_steady_state_yaw", "control.longitudinal.kp", "mission.stop_decel",
+                           "cone_map.min_observations", "gates.post_radius"})
+    EXPECT_TRUE(has(path)) << path;
+  // derived by the runner, or a run-time switch: not parameters of their own
+  for (const char* path : {"seed", "vehicle.mass", "perception.use_camera", "perception.odometry.wheel_radius",
+                           "perception.lidar.calibration.channels", "perception.lidar.keep_points",
+                           "planner.reference.profile.mass", "planner.reference.profile.drag_coefficient",
+                           "skidpad.reference.ds"})
+    EXPECT_FALSE(has(path)) << path;
+}
+
+TEST(StackParams, ValidateChecksTheWholeStackWithPaths) {
+  StackParams p;
+  // a camera is used by default, and its calibration is the runner's to fill
+  EXPECT_EQ(params::validate(p), "perception.camera.width and camera.height must be > 0 px");
+  p.perception.use_camera = false;
+  EXPECT_EQ(params::validate(p), "");
+  StackParams q = p;
+  q.planner.search.horizon_depth = 9;
+  EXPECT_EQ(params::validate(q), "planner.search.horizon_depth must be in [1, 8] (got 9)");
+  q = p;
+  q.gates.max_width = 1.0;
+  EXPECT_EQ(params::validate(q), "gates.max_width must be >= min_width");
+  // not visited, still checked
+  q = p;
+  q.vehicle.mass = 0.0;
+  EXPECT_EQ(params::validate(q), "vehicle.mass must be > 0 kg (got 0)");
+  q = p;
+  q.skidpad.reference.ds = 0.0;
+  EXPECT_EQ(params::validate(q), "skidpad.reference.ds must be in [0.01, 10] m (got 0)");
+  q = p;
+  q.planner.reference.profile.mass = -1.0;
+  EXPECT_EQ(params::validate(q), "planner.reference.profile.mass must be > 0 kg (got -1)");
+  q = p;
+  q.perception.odometry.wheel_radius = 0.0;
+  EXPECT_EQ(params::validate(q), "perception.odometry.wheel_radius must be > 0 m (got 0)");
+  q = p;
+  q.perception.lidar.calibration.channels = 0;
+  EXPECT_EQ(params::validate(q), "perception.lidar.calibration.channels must be in [1, 65535] (got 0)");
 }
 
 }  // namespace
