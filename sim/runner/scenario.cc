@@ -603,14 +603,14 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
                     " Hz) must be a whole multiple of control_rate and log_rate");
   }
   if (const char* why = control::validate(s.control, stack_params(s).vehicle)) throw UserError(path + ": [control] " + why);
-  if (const std::string why = sensors::validate(s.cone_sensor); !why.empty()) throw UserError(path + ": [cone_sensor] " + why);
+  if (const std::string why = params::validate(s.cone_sensor); !why.empty()) throw UserError(path + ": [cone_sensor] " + why);
   if (const auto why = planning::validate(s.planning)) throw UserError(path + ": [planning] " + *why);
-  if (const std::string why = sensors::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
-  if (const std::string why = sensors::validate(s.wheel_speeds); !why.empty()) throw UserError(path + ": [wheel_speeds] " + why);
-  if (const std::string why = sensors::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
+  if (const std::string why = params::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
+  if (const std::string why = params::validate(s.wheel_speeds); !why.empty()) throw UserError(path + ": [wheel_speeds] " + why);
+  if (const std::string why = params::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
   if (const std::string why = params::validate(s.lidar); !why.empty()) throw UserError(path + ": [lidar] " + why);
-  if (const std::string why = sensors::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
-  if (const std::string why = sensors::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
+  if (const std::string why = params::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
+  if (const std::string why = params::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
   if (const std::string why = perception::validate(stack_params(s).perception); !why.empty()) {
     // "detector.range_max ..." is a [detector] key; the rest are [perception]'s or derived
     if (why.rfind("detector.", 0) == 0) throw UserError(path + ": [detector] " + why.substr(9));
