@@ -22,6 +22,13 @@ VehicleParams bench_params() {
   std::ifstream f(path);
   if (!f) throw std::runtime_error("cannot open " + path);
   VehicleParams p;
+  // sets the field named key (the fields as VehicleParams::visit lists them)
+  struct Setter {
+    std::string key, value;
+    void operator()(const char* name, double& field, const params::Spec&) {
+      if (key == name) field = std::stod(value);
+    }
+  };
   std::string line;
   while (std::getline(f, line)) {
     line = line.substr(0, line.find(';'));
@@ -30,11 +37,10 @@ VehicleParams bench_params() {
     std::string key = line.substr(0, eq);
     key.erase(0, key.find_first_not_of(" \t"));
     key.erase(key.find_last_not_of(" \t") + 1);
-    for (const ParamField& field : param_fields()) {
-      if (key == field.name) p.*field.member = std::stod(line.substr(eq + 1));
-    }
+    Setter set{key, line.substr(eq + 1)};
+    p.visit(set);
   }
-  const std::string problem = validate(p);
+  const std::string problem = params::validate(p);
   if (!problem.empty()) throw std::runtime_error(path + ": " + problem);
   return p;
 }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 #include "sim/world/track.h"
 
 namespace paddock::events {
@@ -28,11 +29,20 @@ Rules rules_for(EventKind kind);
 
 // the simulator's judgement calls that the rules leave open
 struct EventParams {
-  double timeout = 900.0;           // s of sim time after the go signal before a DNF
-  double stop_time = 30.0;          // s after the finish within which the car must be at rest
-  double off_track_dnf_time = 5.0;  // s with all four wheels off the track that end the run (DNF)
-  double stall_time = 10.0;         // s at rest on track before the finish that end the run (DNF)
-  double standstill_speed = 0.05;   // m/s; slower counts as at rest
+  double timeout = 900.0;
+  double stop_time = 30.0;
+  double off_track_dnf_time = 5.0;
+  double stall_time = 10.0;
+  double standstill_speed = 0.05;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(timeout), {"s", params::in(1.0, 86400.0), "sim time after the go signal before a DNF"});
+    v(PADDOCK_PARAM(stop_time), {"s", params::in(1.0, 600.0), "time after the finish within which the car must be at rest"});
+    v(PADDOCK_PARAM(off_track_dnf_time), {"s", params::in(0.01, 600.0), "time with all four wheels off the track that ends the run (DNF)"});
+    v(PADDOCK_PARAM(stall_time), {"s", params::in(0.1, 600.0), "time at rest on track before the finish that ends the run (DNF)"});
+    v(PADDOCK_PARAM(standstill_speed), {"m/s", params::in(0.0, 5.0), "slower counts as at rest"});
+  }
 };
 
 struct Lap {

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -118,15 +119,36 @@ Field expect_field(const char* key, const char* unit, const char* doc, Acc acc) 
   return f;
 }
 
+// the field of v named key (VehicleParams::visit lists them); v may be const
+template <class VP>
+auto& vehicle_field(VP& v, const char* key) {
+  struct Find {
+    const char* key;
+    double* field = nullptr;
+    void operator()(const char* name, double& member, const params::Spec&) {
+      if (std::strcmp(name, key) == 0) field = &member;
+    }
+  } find{key};
+  const_cast<vehicle::VehicleParams&>(v).visit(find);
+  assert(find.field);
+  if constexpr (std::is_const_v<VP>) return static_cast<const double&>(*find.field);
+  else return *find.field;
+}
+
 // [vehicle]: every key required (the values come from a vehicle file such as
 // scenarios/vehicles/default.ini, the one place they are written); the vehicle
-// module lists its fields and validates them as a whole after loading
+// module lists its fields (visit) and validates them as a whole after loading
 void add_vehicle_fields(std::vector<Field>& f) {
-  for (const vehicle::ParamField& p : vehicle::param_fields()) {
-    const auto m = p.member;
-    f.push_back(real_field("vehicle", p.name, p.unit, -kInf, kInf, "",
-                           [m](auto& s) -> auto& { return s.vehicle.*m; }, true));
-  }
+  struct Add {
+    std::vector<Field>& f;
+    void operator()(const char* key, double&, const params::Spec& spec) {
+      // "-" marks a dimensionless field in the resolved scenario
+      f.push_back(real_field("vehicle", key, *spec.unit ? spec.unit : "-", -kInf, kInf, "",
+                             [key](auto& s) -> auto& { return vehicle_field(s.vehicle, key); }, true));
+    }
+  } add{f};
+  vehicle::VehicleParams v;
+  v.visit(add);
 }
 
 #define ACC(member) [](auto& s) -> auto& { return s.member; }
@@ -575,7 +597,7 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   }
 
   // whole-scenario checks
-  if (const std::string why = vehicle::validate(s.vehicle); !why.empty()) throw UserError(path + ": [vehicle] " + why);
+  if (const std::string why = params::validate(s.vehicle); !why.empty()) throw UserError(path + ": [vehicle] " + why);
   if (s.sim.physics_rate % s.sim.control_rate != 0 || s.sim.physics_rate % s.sim.log_rate != 0) {
     throw UserError(path + ": [sim] physics_rate (" + std::to_string(s.sim.physics_rate) +
                     " Hz) must be a whole multiple of control_rate and log_rate");
@@ -584,14 +606,14 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   if (const std::string why = params::validate(stack_params(s).vehicle); !why.empty()) {
     throw UserError(path + ": [control] vehicle." + why);
   }
-  if (const std::string why = sensors::validate(s.cone_sensor); !why.empty()) throw UserError(path + ": [cone_sensor] " + why);
+  if (const std::string why = params::validate(s.cone_sensor); !why.empty()) throw UserError(path + ": [cone_sensor] " + why);
   if (const std::string why = params::validate(s.planning); !why.empty()) throw UserError(path + ": [planning] " + why);
-  if (const std::string why = sensors::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
-  if (const std::string why = sensors::validate(s.wheel_speeds); !why.empty()) throw UserError(path + ": [wheel_speeds] " + why);
-  if (const std::string why = sensors::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
+  if (const std::string why = params::validate(s.imu); !why.empty()) throw UserError(path + ": [imu] " + why);
+  if (const std::string why = params::validate(s.wheel_speeds); !why.empty()) throw UserError(path + ": [wheel_speeds] " + why);
+  if (const std::string why = params::validate(s.steering_sensor); !why.empty()) throw UserError(path + ": [steering_sensor] " + why);
   if (const std::string why = params::validate(s.lidar); !why.empty()) throw UserError(path + ": [lidar] " + why);
-  if (const std::string why = sensors::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
-  if (const std::string why = sensors::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
+  if (const std::string why = params::validate(s.ground); !why.empty()) throw UserError(path + ": [ground] " + why);
+  if (const std::string why = params::validate(s.camera); !why.empty()) throw UserError(path + ": [camera] " + why);
   if (const std::string why = sensors::validate(s.detector); !why.empty()) throw UserError(path + ": [detector] " + why);
   if (const std::string why = params::validate(stack_params(s).perception); !why.empty()) {
     throw UserError(path + ": [perception] " + why);

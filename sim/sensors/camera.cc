@@ -8,7 +8,6 @@
 
 #include "sim/sensors/embree_ray.h"
 #include "sim/sensors/gaussian_table.h"
-#include "sim/sensors/param_check.h"
 
 namespace paddock::sensors {
 
@@ -16,11 +15,6 @@ namespace {
 
 std::uint8_t to_byte(double v) {
   return static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(v, 0.0, 1.0)));
-}
-
-bool unit_rgb(const Rgb& c) {
-  const auto in = [](double v) { return finite(v) && v >= 0.0 && v <= 1.0; };
-  return in(c.r) && in(c.g) && in(c.b);
 }
 
 const Rgb& albedo(const CameraParams& p, LidarMaterial m) {
@@ -43,45 +37,6 @@ constexpr std::uint8_t kMaxCover = 255;
 constexpr int kGroundTile = 4;          // px, non-flat ground outside the boxes
 
 }  // namespace
-
-std::string validate(const CameraParams& p) {
-  std::string e;
-  const double deg = kPi / 180.0;
-  if (p.width < 16 || p.width > 8192) {
-    std::ostringstream os;
-    os << "width must be in [16, 8192] px (got " << p.width << ")";
-    return os.str();
-  }
-  if (p.height < 16 || p.height > 8192) {
-    std::ostringstream os;
-    os << "height must be in [16, 8192] px (got " << p.height << ")";
-    return os.str();
-  }
-  if (!(e = check_range("hfov", p.hfov, 10.0 * deg, 170.0 * deg, "rad")).empty()) return e;
-  if (!(e = check_range("mount_x", p.mount_x, -kNoUpperBound, kNoUpperBound, "m")).empty()) return e;
-  if (!(e = check_range("mount_y", p.mount_y, -kNoUpperBound, kNoUpperBound, "m")).empty()) return e;
-  if (!finite(p.mount_z) || !(p.mount_z > 0.0)) {
-    std::ostringstream os;
-    os << "mount_z must be finite and > 0 m (got " << p.mount_z << ")";
-    return os.str();
-  }
-  if (!finite(p.mount_pitch) || !(std::abs(p.mount_pitch) < 0.5 * kPi)) {
-    std::ostringstream os;
-    os << "mount_pitch must be in (-pi/2, pi/2) rad (got " << p.mount_pitch << ")";
-    return os.str();
-  }
-  if (!(e = check_range("trigger_azimuth", p.trigger_azimuth, -kPi, kPi, "rad")).empty()) return e;
-  if (!(e = check_range("sun_azimuth", p.sun_azimuth, -2.0 * kPi, 2.0 * kPi, "rad")).empty()) return e;
-  if (!(e = check_range("sun_elevation", p.sun_elevation, 0.0, 0.5 * kPi, "rad")).empty()) return e;
-  if (!(e = check_range("ambient", p.ambient, 0.0, 1.0, "")).empty()) return e;
-  const std::pair<const char*, const Rgb*> colours[] = {
-      {"sky", &p.sky},       {"ground", &p.ground}, {"blue", &p.blue},   {"yellow", &p.yellow},
-      {"orange", &p.orange}, {"white", &p.white},   {"black", &p.black}, {"grey", &p.grey}};
-  for (const auto& [name, c] : colours) {
-    if (!unit_rgb(*c)) return std::string(name) + " must have r, g, b finite in [0, 1]";
-  }
-  return check_range("pixel_noise", p.pixel_noise, 0.0, 64.0, "levels");
-}
 
 int trigger_column(const LidarParams& lidar, double azimuth) {
   const int n = std::max(lidar.columns, 1);
@@ -119,8 +74,7 @@ perception::CameraCalibration camera_calibration(const CameraParams& p) {
 
 Camera::Camera(const CameraParams& params, std::uint64_t seed)
     : params_(params), rng_(seed) {
-  const std::string err = validate(params_);
-  if (!err.empty()) throw std::invalid_argument("CameraParams: " + err);
+  params::require_valid(params_, "CameraParams");
   calibration_ = camera_calibration(params_);
   const auto w = static_cast<std::size_t>(params_.width);
   const auto h = static_cast<std::size_t>(params_.height);

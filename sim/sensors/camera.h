@@ -76,6 +76,7 @@
 #include <vector>
 
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
 #include "autonomy/hal/messages.h"
 #include "autonomy/perception/types.h"
@@ -86,55 +87,80 @@ namespace paddock::sensors {
 // a linear RGB colour, each channel in [0, 1] (1 = 255 in the image)
 struct Rgb {
   double r = 0.0, g = 0.0, b = 0.0;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(r), {"", params::fraction(), "red"});
+    v(PADDOCK_PARAM(g), {"", params::fraction(), "green"});
+    v(PADDOCK_PARAM(b), {"", params::fraction(), "blue"});
+  }
 };
 
 struct CameraParams {
-  // resolution. 800 x 500 (0.4 MP, 16:10): a frame stays cheap (1.2 MB of
-  // RGB), and with the lens below a small cone (0.325 m) is still 8.7 px tall
-  // at 15 m, where the fusion stops trusting the detector (fusion.h).
-  int width = 800;   // px, in [16, 8192]
-  int height = 500;  // px, in [16, 8192]
-  // horizontal field of view of a wide lens: fx = fy = (width / 2) / tan(hfov / 2)
-  // = 400 px at 90 deg; the vertical field of view follows (64 deg at 800 x 500)
-  double hfov = 90.0 * kPi / 180.0;  // rad, in [10, 170] deg
+  // 800 x 500 (0.4 MP, 16:10): a frame stays cheap (1.2 MB of RGB), and with
+  // the lens below a small cone (0.325 m) is still 8.7 px tall at 15 m, where
+  // the fusion stops trusting the detector (fusion.h).
+  int width = 800;
+  int height = 500;
+  // a wide lens: fx = fy = (width / 2) / tan(hfov / 2) = 400 px at 90 deg;
+  // the vertical field of view follows (64 deg at 800 x 500)
+  double hfov = 90.0 * kPi / 180.0;
   // mounting (chosen): on top of the main hoop as in the paper. The hoop of a
   // 1.53 m wheelbase car stands a little ahead of mid-wheelbase: 0.95 m ahead
   // of the rear axle; 1.20 m above the ground (a hoop top about 1.15 m plus
   // the camera housing). Pitched 5 deg down: the horizon sits 35 px above the
   // image centre, the ground shows from 1.6 m ahead of the camera, and a cone
   // at 20 m (3.4 deg below the horizontal) is still well inside the image.
-  double mount_x = 0.95;                   // m
-  double mount_y = 0.0;                    // m
-  double mount_z = 1.20;                   // m, above the ground, > 0
-  double mount_pitch = 5.0 * kPi / 180.0;  // rad, > 0 nose down, in (-pi/2, pi/2)
-  // the LiDAR triggers the camera when its column at this azimuth (lidar
-  // frame, rad, 0 = straight ahead) fires: once a rotation (trigger_time)
-  double trigger_azimuth = 0.0;  // rad, in [-pi, pi]
+  double mount_x = 0.95;
+  double mount_y = 0.0;
+  double mount_z = 1.20;
+  double mount_pitch = 5.0 * kPi / 180.0;
+  // the LiDAR triggers the camera once a rotation (trigger_time)
+  double trigger_azimuth = 0.0;
   // lighting: a sun 50 deg high from the south-west of the map frame, and
   // 35 % ambient so faces turned away from it keep their colour
-  double sun_azimuth = -2.4;                   // rad, from map +x, counter-clockwise
-  double sun_elevation = 50.0 * kPi / 180.0;   // rad, in [0, pi/2]
-  double ambient = 0.35;                       // -, in [0, 1]
+  double sun_azimuth = -2.4;
+  double sun_elevation = 50.0 * kPi / 180.0;
+  double ambient = 0.35;
   // materials' colours (albedo; the sky's is its colour as seen)
   Rgb sky{0.55, 0.72, 0.92};
-  Rgb ground{0.32, 0.32, 0.34};  // asphalt
+  Rgb ground{0.32, 0.32, 0.34};
   Rgb blue{0.05, 0.22, 0.80};
   Rgb yellow{0.98, 0.82, 0.05};
   Rgb orange{0.98, 0.42, 0.05};
   Rgb white{0.95, 0.95, 0.95};
   Rgb black{0.06, 0.06, 0.06};
-  Rgb grey{0.50, 0.50, 0.50};  // cones of unknown colour
-  // Gaussian pixel noise std, per channel, in 8-bit levels, drawn from the
-  // table of 4096 quantiles of gaussian_table.h (so cut at 3.67 sigma),
-  // rounded to whole levels;
-  // 0 = off (the default: the annotation detector does not look at the
-  // pixels, and noise costs about 2 ms a frame at 800 x 500)
-  double pixel_noise = 0.0;  // levels, in [0, 64]
-};
+  Rgb grey{0.50, 0.50, 0.50};
+  // per channel, drawn from the table of 4096 quantiles of gaussian_table.h
+  // (so cut at 3.67 sigma), rounded to whole levels; 0 = off (the default:
+  // the annotation detector does not look at the pixels, and noise costs
+  // about 2 ms a frame at 800 x 500)
+  double pixel_noise = 0.0;
 
-// "" when every field is usable, else the first problem, starting with the
-// field name
-std::string validate(const CameraParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(width), {"px", params::in(16, 8192), "image width"});
+    v(PADDOCK_PARAM(height), {"px", params::in(16, 8192), "image height"});
+    v(PADDOCK_PARAM(hfov), {"rad", params::in(10.0 * kPi / 180.0, 170.0 * kPi / 180.0), "horizontal field of view"});
+    v(PADDOCK_PARAM(mount_x), {"m", params::in(-10.0, 10.0), "optical centre ahead of the rear axle"});
+    v(PADDOCK_PARAM(mount_y), {"m", params::in(-5.0, 5.0), "optical centre left of the centre"});
+    v(PADDOCK_PARAM(mount_z), {"m", params::in(0.01, 5.0), "optical centre above the ground"});
+    v(PADDOCK_PARAM(mount_pitch), {"rad", params::in(-1.5, 1.5), "pitch, > 0 nose down"});
+    v(PADDOCK_PARAM(trigger_azimuth), {"rad", params::in(-kPi, kPi), "the LiDAR azimuth (lidar frame, 0 ahead) whose column's firing triggers the exposure"});
+    v(PADDOCK_PARAM(sun_azimuth), {"rad", params::in(-kPi, kPi), "sun direction from map +x, counter-clockwise"});
+    v(PADDOCK_PARAM(sun_elevation), {"rad", params::in(0.0, kPi / 2), "sun height"});
+    v(PADDOCK_PARAM(ambient), {"", params::fraction(), "ambient light share"});
+    v.section(PADDOCK_PARAM(sky), "the sky's colour");
+    v.section(PADDOCK_PARAM(ground), "the asphalt's albedo");
+    v.section(PADDOCK_PARAM(blue), "a blue cone body's albedo");
+    v.section(PADDOCK_PARAM(yellow), "a yellow cone body's albedo");
+    v.section(PADDOCK_PARAM(orange), "an orange cone body's albedo");
+    v.section(PADDOCK_PARAM(white), "a white stripe's albedo");
+    v.section(PADDOCK_PARAM(black), "a black stripe's albedo");
+    v.section(PADDOCK_PARAM(grey), "the albedo of a cone of unknown colour");
+    v(PADDOCK_PARAM(pixel_noise), {"", params::in(0.0, 64.0), "Gaussian pixel noise std in 8-bit levels (0: off)"});
+  }
+};
 
 // the simulation's annotation of one cone seen by the camera (a labelled data
 // set's box label); a hardware camera gives none
@@ -173,7 +199,7 @@ perception::CameraCalibration camera_calibration(const CameraParams& p);
 
 class Camera {
  public:
-  // throws std::invalid_argument when validate(params) fails. The seed starts
+  // throws std::invalid_argument when params::validate(params) fails. The seed starts
   // this sensor's own random stream (std::mt19937_64; drawn from only when
   // pixel_noise > 0).
   Camera(const CameraParams& params, std::uint64_t seed);

@@ -4,86 +4,33 @@
 #include <cassert>
 #include <cmath>
 #include <sstream>
-#include <stdexcept>
 
 namespace paddock::sensors {
 
-namespace {
-
-// one bound check: value within [lo, hi] (open ends when lo_open / hi_open)
-struct Range {
-  const char* name;
-  double value;
-  double lo;
-  bool lo_open;
-  double hi;
-  bool hi_open;
-  const char* unit;
-};
-
-std::string check(const Range& c) {
-  const bool ok = std::isfinite(c.value) && (c.lo_open ? c.value > c.lo : c.value >= c.lo) &&
-                  (c.hi_open ? c.value < c.hi : c.value <= c.hi);
-  if (ok) return {};
+std::string ConeSensorParams::check() const {
+  // the radii are not visited (the runner sets them): their bounds are here
+  if (!params::above(0.0).contains(small_cone_radius))
+    return "small_cone_radius must be > 0 m (got " + params::number(small_cone_radius) + ")";
+  if (!params::above(0.0).contains(big_cone_radius))
+    return "big_cone_radius must be > 0 m (got " + params::number(big_cone_radius) + ")";
   std::ostringstream s;
-  s << c.name << " must be a finite number in " << (c.lo_open ? "(" : "[") << c.lo << ", " << c.hi
-    << (c.hi_open ? ")" : "]") << (c.unit[0] ? " " : "") << c.unit << " (got " << c.value << ")";
-  return s.str();
-}
-
-constexpr double kInf = 1e300;  // "no upper bound" that still prints as a number
-
-}  // namespace
-
-std::string validate(const ConeSensorParams& p) {
-  const Range checks[] = {
-      {"mount_x", p.mount_x, -kInf, false, kInf, false, "m"},
-      {"mount_y", p.mount_y, -kInf, false, kInf, false, "m"},
-      {"range_min", p.range_min, 0.0, false, kInf, false, "m"},
-      {"range_max", p.range_max, 0.0, true, kInf, false, "m"},
-      {"fov", p.fov, 0.0, true, 2.0 * kPi, false, "rad"},
-      {"occlusion_fraction", p.occlusion_fraction, 0.0, true, 1.0, false, ""},
-      {"small_cone_radius", p.small_cone_radius, 0.0, true, kInf, false, "m"},
-      {"big_cone_radius", p.big_cone_radius, 0.0, true, kInf, false, "m"},
-      {"range_noise", p.range_noise, 0.0, false, kInf, false, "m"},
-      {"range_noise_per_m", p.range_noise_per_m, 0.0, false, kInf, false, "m/m"},
-      {"bearing_noise", p.bearing_noise, 0.0, false, kInf, false, "rad"},
-      {"miss_probability", p.miss_probability, 0.0, false, 1.0, false, ""},
-      {"miss_probability_growth", p.miss_probability_growth, 0.0, false, 1.0, false, ""},
-      {"unknown_color_probability", p.unknown_color_probability, 0.0, false, 1.0, false, ""},
-      {"unknown_color_growth", p.unknown_color_growth, 0.0, false, 1.0, false, ""},
-      {"color_flip_probability", p.color_flip_probability, 0.0, false, 1.0, false, ""},
-      {"color_flip_growth", p.color_flip_growth, 0.0, false, 1.0, false, ""},
-      // a bound that keeps the Poisson draw and the frame size sane
-      {"false_positives_per_frame", p.false_positives_per_frame, 0.0, false, 1000.0, false, "1/frame"},
-      {"false_positive_unknown_probability", p.false_positive_unknown_probability, 0.0, false, 1.0, false, ""},
-      {"latency", p.latency, 0.0, false, 60.0, false, "s"},
-      {"rate", p.rate, 0.0, true, 1e6, false, "Hz"},
-  };
-  for (const Range& c : checks) {
-    std::string msg = check(c);
-    if (!msg.empty()) return msg;
-  }
-  // the relations between fields
-  std::ostringstream s;
-  if (!(p.range_max > p.range_min)) {
-    s << "range_max must be > range_min (got " << p.range_max << " <= " << p.range_min << ")";
-  } else if (p.miss_probability + p.miss_probability_growth > 1.0) {
+  if (!(range_max > range_min)) {
+    s << "range_max must be > range_min (got " << range_max << " <= " << range_min << ")";
+  } else if (miss_probability + miss_probability_growth > 1.0) {
     s << "miss_probability_growth must keep miss_probability + miss_probability_growth <= 1 (got "
-      << p.miss_probability + p.miss_probability_growth << ")";
-  } else if (p.unknown_color_probability + p.unknown_color_growth > 1.0) {
+      << miss_probability + miss_probability_growth << ")";
+  } else if (unknown_color_probability + unknown_color_growth > 1.0) {
     s << "unknown_color_growth must keep unknown_color_probability + unknown_color_growth <= 1 (got "
-      << p.unknown_color_probability + p.unknown_color_growth << ")";
-  } else if (p.color_flip_probability + p.color_flip_growth > 1.0) {
+      << unknown_color_probability + unknown_color_growth << ")";
+  } else if (color_flip_probability + color_flip_growth > 1.0) {
     s << "color_flip_growth must keep color_flip_probability + color_flip_growth <= 1 (got "
-      << p.color_flip_probability + p.color_flip_growth << ")";
+      << color_flip_probability + color_flip_growth << ")";
   }
   return s.str();
 }
 
 ConeSensor::ConeSensor(const ConeSensorParams& params, std::uint64_t seed) : params_(params), rng_(seed) {
-  const std::string msg = validate(params);
-  if (!msg.empty()) throw std::invalid_argument("cone sensor: " + msg);
+  params::require_valid(params_, "ConeSensorParams");
 }
 
 double ConeSensor::uniform() {

@@ -1,47 +1,11 @@
 #include "sim/sensors/imu.h"
 
 #include <cmath>
-#include <sstream>
-#include <stdexcept>
-
-#include "sim/sensors/param_check.h"
 
 namespace paddock::sensors {
 
-std::string validate(const ImuParams& p) {
-  // rate: positive; 100 kHz bounds the sample count of a run
-  if (!(std::isfinite(p.rate) && p.rate > 0.0 && p.rate <= 1e5)) {
-    std::ostringstream s;
-    s << "rate must be a finite number in (0, 100000] Hz (got " << p.rate << ")";
-    return s.str();
-  }
-  struct Field {
-    const char* name;
-    double value;
-    double lo;
-    double hi;
-    const char* unit;
-  };
-  const Field fields[] = {
-      {"accel_noise", p.accel_noise, 0.0, kNoUpperBound, "m/s^2"},
-      {"gyro_noise", p.gyro_noise, 0.0, kNoUpperBound, "rad/s"},
-      {"accel_bias_walk", p.accel_bias_walk, 0.0, kNoUpperBound, "m/s^2/sqrt(s)"},
-      {"gyro_bias_walk", p.gyro_bias_walk, 0.0, kNoUpperBound, "rad/s/sqrt(s)"},
-      {"accel_bias_initial_std", p.accel_bias_initial_std, 0.0, kNoUpperBound, "m/s^2"},
-      {"gyro_bias_initial_std", p.gyro_bias_initial_std, 0.0, kNoUpperBound, "rad/s"},
-      {"mount_x", p.mount_x, -kNoUpperBound, kNoUpperBound, "m"},
-      {"mount_y", p.mount_y, -kNoUpperBound, kNoUpperBound, "m"},
-  };
-  for (const Field& f : fields) {
-    std::string msg = check_range(f.name, f.value, f.lo, f.hi, f.unit);
-    if (!msg.empty()) return msg;
-  }
-  return {};
-}
-
 Imu::Imu(const ImuParams& params, std::uint64_t seed) : params_(params), rng_(seed) {
-  const std::string msg = validate(params);
-  if (!msg.empty()) throw std::invalid_argument("imu: " + msg);
+  params::require_valid(params_, "ImuParams");
   // the turn-on biases, three draws in a fixed order
   const double g_ax = gaussian(), g_ay = gaussian(), g_gz = gaussian();
   bias_.ax = params_.accel_bias_initial_std * g_ax;

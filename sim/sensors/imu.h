@@ -10,8 +10,8 @@
 // biases and the previous stamp (Imu). No I/O, no clock, no global state.
 #include <cstdint>
 #include <random>
-#include <string>
 
+#include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
 
 namespace paddock::sensors {
@@ -21,8 +21,8 @@ namespace paddock::sensors {
 // ADIS16448 class) after the standstill calibration an FS car does in the
 // staging area; each says why.
 struct ImuParams {
-  // samples per second (DESIGN.md default rates)
-  double rate = 200.0;  // Hz
+  // DESIGN.md default rates
+  double rate = 200.0;
 
   // white noise std PER SAMPLE. A data sheet gives a noise density n (per
   // sqrt(Hz)); sampled at `rate` with the anti-alias filter at Nyquist the
@@ -30,10 +30,10 @@ struct ImuParams {
   // accel: 150 ug/sqrt(Hz) (BMI088: 175, MTi-630: 60) = 1.5e-3 m/s^2/sqrt(Hz)
   // -> 0.015 m/s^2 at 200 Hz; rounded up to 0.02 for the residual vibration
   // a stiff mount on a monocoque still passes.
-  double accel_noise = 0.02;  // m/s^2, std per sample
+  double accel_noise = 0.02;
   // gyro: 0.01 deg/s/sqrt(Hz) (BMI088: 0.014, MTi-630: 0.007) = 1.75e-4
   // rad/s/sqrt(Hz) -> 1.75e-3 rad/s at 200 Hz; rounded to 0.002.
-  double gyro_noise = 0.002;  // rad/s, std per sample
+  double gyro_noise = 0.002;
 
   // bias random walk: b_{k+1} = b_k + walk * sqrt(dt) * N(0, 1), so the bias
   // variance grows by walk^2 per second. The Kalibr reference values of an
@@ -41,28 +41,37 @@ struct ImuParams {
   // gyroscope_random_walk 1.9e-5 rad/s^2/sqrt(Hz)): over a 10-minute run the
   // accel bias drifts by ~7 mm/s^2 (1 sigma) and the gyro bias by ~5e-4 rad/s
   // (0.03 deg/s), small against the turn-on residuals below, as on a real car.
-  double accel_bias_walk = 3e-4;  // m/s^2 per sqrt(s)
-  double gyro_bias_walk = 2e-5;   // rad/s per sqrt(s)
+  double accel_bias_walk = 3e-4;
+  double gyro_bias_walk = 2e-5;
 
   // turn-on bias std, drawn once per sensor (per run). What is left after a
   // standstill calibration: accel 0.02 m/s^2 (2 mg, the tilt of the ground
   // and the repeatability of a MEMS accelerometer's offset), gyro 1e-3 rad/s
   // (0.06 deg/s; BMI088's uncalibrated zero-rate offset is up to 1 deg/s, a
   // few seconds of standstill averaging remove all but a drift-limited rest).
-  double accel_bias_initial_std = 0.02;  // m/s^2
-  double gyro_bias_initial_std = 1e-3;   // rad/s
+  double accel_bias_initial_std = 0.02;
+  double gyro_bias_initial_std = 1e-3;
 
   // mounting of the sensor origin in the base frame (rear axle centre, x
   // forward, y left); the axes are the base frame's. 0.765 m: at the CG of
   // the default vehicle (lr = 0.765 m), where FS teams put the IMU so that it
   // sees no lever-arm terms.
-  double mount_x = 0.765;  // m
-  double mount_y = 0.0;    // m
-};
+  double mount_x = 0.765;
+  double mount_y = 0.0;
 
-// "" when every field is usable, else the first problem, starting with the
-// field name, e.g. "gyro_noise must be a finite number in [0, 1e+300] rad/s (got -1)"
-std::string validate(const ImuParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(rate), {"Hz", params::in(1.0, 10000.0), "samples per second"});
+    v(PADDOCK_PARAM(accel_noise), {"m/s^2", params::in(0.0, 100.0), "accelerometer white noise std per sample"});
+    v(PADDOCK_PARAM(gyro_noise), {"rad/s", params::in(0.0, 10.0), "gyro white noise std per sample"});
+    v(PADDOCK_PARAM(accel_bias_walk), {"m/s^2/sqrt(s)", params::in(0.0, 10.0), "accelerometer bias random walk"});
+    v(PADDOCK_PARAM(gyro_bias_walk), {"rad/s/sqrt(s)", params::in(0.0, 10.0), "gyro bias random walk"});
+    v(PADDOCK_PARAM(accel_bias_initial_std), {"m/s^2", params::in(0.0, 10.0), "turn-on accelerometer bias std"});
+    v(PADDOCK_PARAM(gyro_bias_initial_std), {"rad/s", params::in(0.0, 10.0), "turn-on gyro bias std"});
+    v(PADDOCK_PARAM(mount_x), {"m", params::in(-10.0, 10.0), "IMU position ahead of the rear axle"});
+    v(PADDOCK_PARAM(mount_y), {"m", params::in(-5.0, 5.0), "IMU position left of the centre"});
+  }
+};
 
 // one IMU sample, in the sensor frame (= base frame orientation)
 struct ImuSample {
@@ -81,7 +90,7 @@ struct ImuBias {
 
 class Imu {
  public:
-  // throws std::invalid_argument when validate(params) fails. The seed starts
+  // throws std::invalid_argument when params::validate(params) fails. The seed starts
   // this sensor's own random stream (std::mt19937_64) and draws the turn-on
   // biases: the same seed and the same inputs give the same samples.
   Imu(const ImuParams& params, std::uint64_t seed);

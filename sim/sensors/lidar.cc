@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "sim/sensors/embree_ray.h"
 #include "sim/sensors/gaussian_table.h"
@@ -69,20 +68,6 @@ double reflectivity(const LidarParams& p, LidarMaterial m) {
   return 0.0;
 }
 
-std::string validate(const GroundParams& g) {
-  std::ostringstream os;
-  if (!finite(g.slope_x) || !finite(g.slope_y)) {
-    os << "slope_x and slope_y must be finite";
-  } else if (!finite(g.bump_height)) {
-    os << "bump_height must be finite (got " << g.bump_height << ")";
-  } else if (!finite(g.bump_wavelength) || !(g.bump_wavelength > 0.0)) {
-    os << "bump_wavelength must be finite and > 0 (got " << g.bump_wavelength << ")";
-  } else if (!finite(g.cell) || !(g.cell > 0.0)) {
-    os << "cell must be finite and > 0 (got " << g.cell << ")";
-  }
-  return os.str();
-}
-
 bool flat(const GroundParams& g) {
   return g.slope_x == 0.0 && g.slope_y == 0.0 && g.bump_height == 0.0;
 }
@@ -104,10 +89,7 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
   if (!knocked.empty() && knocked.size() != cones.size()) {
     throw std::invalid_argument("LidarWorld: knocked must be empty or of the size of cones");
   }
-  {
-    const std::string err = validate(ground_);
-    if (!err.empty()) throw std::invalid_argument("LidarWorld: GroundParams: " + err);
-  }
+  params::require_valid(ground_, "LidarWorld: GroundParams");
   // one worker thread: many simulations may run side by side in one process
   device_ = rtcNewDevice("threads=1");
   if (device_ == nullptr) {

@@ -112,14 +112,20 @@ class LidarError : public std::runtime_error {
 
 // the ground's height field, world frame
 struct GroundParams {
-  double slope_x = 0.0, slope_y = 0.0;  // -, dz/dx and dz/dy of the plane
-  double bump_height = 0.0;             // m, amplitude of the bumps
-  double bump_wavelength = 10.0;        // m, > 0
-  double cell = 0.5;                    // m, > 0: the grid's cell (a lower bound, see LidarWorld)
-};
+  double slope_x = 0.0, slope_y = 0.0;
+  double bump_height = 0.0;
+  double bump_wavelength = 10.0;
+  double cell = 0.5;
 
-// "" when every field is usable, else the first problem
-std::string validate(const GroundParams& g);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(slope_x), {"", params::in(-1.0, 1.0), "dz/dx of the ground plane (map frame)"});
+    v(PADDOCK_PARAM(slope_y), {"", params::in(-1.0, 1.0), "dz/dy of the ground plane (map frame)"});
+    v(PADDOCK_PARAM(bump_height), {"m", params::in(0.0, 1.0), "amplitude of the sinusoidal bumps"});
+    v(PADDOCK_PARAM(bump_wavelength), {"m", params::in(0.1, 1000.0), "wavelength of the bumps"});
+    v(PADDOCK_PARAM(cell), {"m", params::in(0.01, 100.0), "height-field grid cell (a lower bound, see LidarWorld)"});
+  }
+};
 
 // true when g is the plane z = 0 (no slope, no bumps)
 bool flat(const GroundParams& g);
@@ -188,7 +194,7 @@ class LidarWorld {
   static constexpr double kMaxGridCells = 200000.0;  // -, height-field ground
   // throws LidarError on an Embree failure, std::invalid_argument when knocked
   // is neither empty (no cone knocked) nor of the size of cones, or when
-  // validate(ground) fails. Cones with a non-finite position are left out (and
+  // params::validate(ground) fails. Cones with a non-finite position are left out (and
   // are never reported as hit).
   explicit LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked = {},
                       const GroundParams& ground = {});
@@ -242,7 +248,7 @@ struct LidarPoint {
 
 class Lidar {
  public:
-  // throws std::invalid_argument when validate(params) fails. The seed starts
+  // throws std::invalid_argument when params::validate(params) fails. The seed starts
   // this sensor's own random stream (std::mt19937_64).
   Lidar(const LidarParams& params, std::uint64_t seed);
 

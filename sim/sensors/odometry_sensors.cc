@@ -2,49 +2,18 @@
 
 #include <cmath>
 #include <cstddef>
-#include <sstream>
-#include <stdexcept>
-
-#include "autonomy/common/geometry.h"
-
-#include "sim/sensors/param_check.h"
 
 namespace paddock::sensors {
 
 namespace {
-
-// rate: positive; 100 kHz bounds the sample count of a run
-std::string check_rate(double rate) {
-  if (std::isfinite(rate) && rate > 0.0 && rate <= 1e5) return {};
-  std::ostringstream s;
-  s << "rate must be a finite number in (0, 100000] Hz (got " << rate << ")";
-  return s.str();
-}
 
 // the nearest multiple of step (ties away from zero); step 0: unchanged
 double quantise(double v, double step) { return step > 0.0 ? step * std::round(v / step) : v; }
 
 }  // namespace
 
-std::string validate(const WheelSpeedParams& p) {
-  std::string msg = check_rate(p.rate);
-  if (msg.empty()) msg = check_range("noise", p.noise, 0.0, kNoUpperBound, "rad/s");
-  if (msg.empty()) msg = check_range("resolution", p.resolution, 0.0, kNoUpperBound, "rad/s");
-  return msg;
-}
-
-std::string validate(const SteeringSensorParams& p) {
-  std::string msg = check_rate(p.rate);
-  if (msg.empty()) msg = check_range("noise", p.noise, 0.0, kNoUpperBound, "rad");
-  if (msg.empty()) msg = check_range("resolution", p.resolution, 0.0, kNoUpperBound, "rad");
-  // a zero more than a quarter turn of road wheel off is not a calibration
-  if (msg.empty()) msg = check_range("offset", p.offset, -0.5 * kPi, 0.5 * kPi, "rad");
-  return msg;
-}
-
 WheelSpeedSensor::WheelSpeedSensor(const WheelSpeedParams& params, std::uint64_t seed) : params_(params), rng_(seed) {
-  const std::string msg = validate(params);
-  if (!msg.empty()) throw std::invalid_argument("wheel speed sensor: " + msg);
+  params::require_valid(params_, "WheelSpeedParams");
 }
 
 WheelSpeedSample WheelSpeedSensor::measure(const std::array<double, 4>& true_omega, TimeNs stamp) {
@@ -72,8 +41,7 @@ WheelSpeedSample WheelSpeedSensor::measure(const std::array<double, 4>& true_ome
 }
 
 SteeringSensor::SteeringSensor(const SteeringSensorParams& params, std::uint64_t seed) : params_(params), rng_(seed) {
-  const std::string msg = validate(params);
-  if (!msg.empty()) throw std::invalid_argument("steering sensor: " + msg);
+  params::require_valid(params_, "SteeringSensorParams");
 }
 
 SteeringSample SteeringSensor::measure(double true_angle, TimeNs stamp) {

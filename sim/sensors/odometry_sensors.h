@@ -10,36 +10,38 @@
 #include <array>
 #include <cstdint>
 #include <random>
-#include <string>
 
+#include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
 
 namespace paddock::sensors {
 
 // every field is the INI key `[wheel_speeds] <field>`
 struct WheelSpeedParams {
-  // samples per second (DESIGN.md default rates)
-  double rate = 100.0;  // Hz
+  // DESIGN.md default rates
+  double rate = 100.0;
 
-  // white noise std per sample, added before the quantisation. 0.05 rad/s
-  // (1.2 cm/s at the default 0.231 m rolling radius): the tooth/line spacing
-  // errors of the encoder disc, the jitter of the 10 ms counting window and
-  // the hub's torsional vibration, a fraction of one count.
-  double noise = 0.05;  // rad/s, std
+  // added before the quantisation. 0.05 rad/s (1.2 cm/s at the default
+  // 0.231 m rolling radius): the tooth/line spacing errors of the encoder
+  // disc, the jitter of the 10 ms counting window and the hub's torsional
+  // vibration, a fraction of one count.
+  double noise = 0.05;
 
-  // quantisation step. A wheel encoder counts the edges seen in each sample
-  // window of 1 / rate; one edge is 2 pi / N rad of wheel for N edges per
-  // turn, so the speed comes in steps of 2 pi * rate / N. The default: a
-  // 2048-line quadrature encoder on the hub (N = 4 * 2048 = 8192 edges per
-  // turn) read at 100 Hz: 2 pi * 100 / 8192 = 0.0767 rad/s (1.8 cm/s of car
-  // speed). Keep it in step with `rate` when changing either. 0: no
-  // quantisation.
-  double resolution = 0.0767;  // rad/s
+  // a wheel encoder counts the edges seen in each sample window of 1 / rate;
+  // one edge is 2 pi / N rad of wheel for N edges per turn, so the speed
+  // comes in steps of 2 pi * rate / N. The default: a 2048-line quadrature
+  // encoder on the hub (N = 4 * 2048 = 8192 edges per turn) read at 100 Hz:
+  // 2 pi * 100 / 8192 = 0.0767 rad/s (1.8 cm/s of car speed). Keep it in
+  // step with `rate` when changing either.
+  double resolution = 0.0767;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(rate), {"Hz", params::in(1.0, 10000.0), "samples per second"});
+    v(PADDOCK_PARAM(noise), {"rad/s", params::in(0.0, 100.0), "white noise std per sample"});
+    v(PADDOCK_PARAM(resolution), {"rad/s", params::in(0.0, 100.0), "quantisation step (0: none)"});
+  }
 };
-
-// "" when every field is usable, else the first problem, starting with the
-// field name, e.g. "noise must be a finite number in [0, 1e+300] rad/s (got -1)"
-std::string validate(const WheelSpeedParams& p);
 
 // one wheel-speed sample
 struct WheelSpeedSample {
@@ -49,7 +51,7 @@ struct WheelSpeedSample {
 
 class WheelSpeedSensor {
  public:
-  // throws std::invalid_argument when validate(params) fails. The seed starts
+  // throws std::invalid_argument when params::validate(params) fails. The seed starts
   // this sensor's own random stream (std::mt19937_64).
   WheelSpeedSensor(const WheelSpeedParams& params, std::uint64_t seed);
 
@@ -75,27 +77,32 @@ class WheelSpeedSensor {
 // every field is the INI key `[steering_sensor] <field>`. The angle is the
 // road-wheel angle, the quantity of the steering command (rad, > 0 left).
 struct SteeringSensorParams {
-  // samples per second: the control rate (DESIGN.md default rates)
-  double rate = 100.0;  // Hz
+  // the control rate (DESIGN.md default rates)
+  double rate = 100.0;
 
-  // white noise std per sample. 0.5 mrad (0.03 deg) of road-wheel angle: a
-  // magnetic absolute encoder's jitter (~0.05 deg rms at the column, divided
-  // by the steering ratio) plus the rack's play under vibration.
-  double noise = 5e-4;  // rad, std
+  // 0.5 mrad (0.03 deg) of road-wheel angle: a magnetic absolute encoder's
+  // jitter (~0.05 deg rms at the column, divided by the steering ratio) plus
+  // the rack's play under vibration.
+  double noise = 5e-4;
 
-  // quantisation step. A 12-bit absolute magnetic encoder on the steering
-  // column (AS5600 class, 2 pi / 4096 = 1.53 mrad of column) through an FS
-  // steering ratio of about 5:1: 2 pi / 4096 / 5 = 0.307 mrad of road wheel.
-  // 0: no quantisation.
-  double resolution = 3.07e-4;  // rad
+  // a 12-bit absolute magnetic encoder on the steering column (AS5600 class,
+  // 2 pi / 4096 = 1.53 mrad of column) through an FS steering ratio of about
+  // 5:1: 2 pi / 4096 / 5 = 0.307 mrad of road wheel.
+  double resolution = 3.07e-4;
 
-  // calibration offset: the reading is true + offset (a zero that was set
-  // with the wheels not quite straight). Default 0: a calibrated car.
-  double offset = 0.0;  // rad
+  // a zero that was set with the wheels not quite straight. Default 0: a
+  // calibrated car.
+  double offset = 0.0;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(rate), {"Hz", params::in(1.0, 10000.0), "samples per second"});
+    v(PADDOCK_PARAM(noise), {"rad", params::in(0.0, 1.0), "white noise std per sample"});
+    v(PADDOCK_PARAM(resolution), {"rad", params::in(0.0, 1.0), "quantisation step (0: none)"});
+    // a zero about a quarter turn of road wheel off is not a calibration
+    v(PADDOCK_PARAM(offset), {"rad", params::in(-1.5, 1.5), "calibration offset: the reading is true + offset"});
+  }
 };
-
-// "" when every field is usable, else the first problem, starting with the field name
-std::string validate(const SteeringSensorParams& p);
 
 // one steering-angle sample
 struct SteeringSample {
@@ -105,7 +112,7 @@ struct SteeringSample {
 
 class SteeringSensor {
  public:
-  // throws std::invalid_argument when validate(params) fails. The seed starts
+  // throws std::invalid_argument when params::validate(params) fails. The seed starts
   // this sensor's own random stream (std::mt19937_64).
   SteeringSensor(const SteeringSensorParams& params, std::uint64_t seed);
 

@@ -10,75 +10,98 @@
 #include <array>
 #include <cstddef>
 #include <limits>
-#include <string>
-#include <vector>
 
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 
 namespace paddock::vehicle {
 
 inline constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
 
-// every physical parameter of the car. No defaults in code: each field starts as
-// NaN and gets its value from scenarios/vehicles/default.ini (keys = field names);
-// validate() rejects a field left unset.
-struct VehicleParams {
-  // mass and geometry
-  double mass = kUnset;               // kg, total mass of the car
-  double inertia_z = kUnset;          // kg m^2, yaw moment of inertia about the CG
-  double lf = kUnset;                 // m, CG to front axle (along x)
-  double lr = kUnset;                 // m, CG to rear axle (along x)
-  double h_cg = kUnset;               // m, CG height above ground (longitudinal load transfer)
-  double track_front = kUnset;        // m, distance between the front contact patches
-  double track_rear = kUnset;         // m, distance between the rear contact patches
-  double wheel_radius = kUnset;       // m, dynamic rolling radius
-  // tyre: Pacejka magic formula, lateral, mu_y(a) = D sin(C atan(B a - E (B a - atan(B a))))
-  double tyre_b = kUnset;             // 1/rad, stiffness factor B
-  double tyre_c = kUnset;             // -, shape factor C
-  double tyre_d = kUnset;             // -, peak friction coefficient D (also the friction ellipse radius)
-  double tyre_e = kUnset;             // -, curvature factor E
-  // aero
-  double c_down = kUnset;             // N s^2/m^2, downforce F = c_down vx^2
-  double aero_balance_front = kUnset; // -, share of the downforce on the front axle
-  double c_drag = kUnset;             // N s^2/m^2, drag F = c_drag vx^2
-  // drivetrain and brakes
-  double cm1 = kUnset;                // N, motor force at full throttle (all driven wheels)
-  double cr0 = kUnset;                // N, rolling resistance
-  double drive_split_front = kUnset;  // -, share of the motor force on the front axle
-  double brake_force_max = kUnset;    // N, total brake force at full brake
-  double brake_split_front = kUnset;  // -, share of the brake force on the front axle (brake balance)
-  // load transfer
-  double pitch_time_constant = kUnset; // s, lag of the longitudinal load transfer behind the acceleration (pitch dynamics)
-  // actuators
-  double steering_max = kUnset;       // rad, road-wheel angle limit (symmetric)
-  double steering_rate_max = kUnset;  // rad/s, road-wheel angle rate limit
-  double steering_time_constant = kUnset; // s, first-order lag of the steering actuator (< dt/2: instantaneous)
-  double steering_dead_time = kUnset; // s, pure delay on the steering command (rounded to whole steps)
-  double throttle_time_constant = kUnset; // s, first-order lag of the motor force (< dt/2: instantaneous)
-  double brake_time_constant = kUnset;    // s, first-order lag of the brake force (< dt/2: instantaneous)
-  // footprint for collisions (a rectangle in the base frame)
-  double front_overhang = kUnset;     // m, front axle to the front of the car (nose, front wing)
-  double rear_overhang = kUnset;      // m, rear axle to the back of the car
-  double body_width = kUnset;         // m, overall width (tyres included)
-};
-
-// one field of VehicleParams, for the INI loader and writer: the key is the field name
-struct ParamField {
-  const char* name;
-  double VehicleParams::*member;
-  const char* unit;
-};
-// every field of VehicleParams, in declaration order
-const std::vector<ParamField>& param_fields();
-
 // the longest steering dead time the state's delay line can hold, in steps
 inline constexpr std::size_t kMaxDelaySteps = 255;
-// the longest steering dead time validate() accepts, s (kMaxDelaySteps at 1 kHz, with margin)
+// the longest steering dead time VehicleParams accepts, s (kMaxDelaySteps at 1 kHz, with margin)
 inline constexpr double kMaxSteeringDeadTime = 0.25;
 
-// empty when every field is finite and physically valid, else the first problem,
-// starting with the field name, e.g. "mass must be > 0 kg (got -1)"
-std::string validate(const VehicleParams& p);
+// every physical parameter of the car. No defaults in code: each field starts as
+// NaN and gets its value from scenarios/vehicles/default.ini (keys = field names);
+// params::validate() rejects a field left unset (NaN is outside every bound).
+struct VehicleParams {
+  // mass and geometry
+  double mass = kUnset;
+  double inertia_z = kUnset;
+  double lf = kUnset;
+  double lr = kUnset;
+  double h_cg = kUnset;
+  double track_front = kUnset;
+  double track_rear = kUnset;
+  double wheel_radius = kUnset;
+  // tyre: Pacejka magic formula, lateral, mu_y(a) = D sin(C atan(B a - E (B a - atan(B a))))
+  double tyre_b = kUnset;
+  double tyre_c = kUnset;
+  double tyre_d = kUnset;
+  double tyre_e = kUnset;
+  // aero
+  double c_down = kUnset;
+  double aero_balance_front = kUnset;
+  double c_drag = kUnset;
+  // drivetrain and brakes
+  double cm1 = kUnset;
+  double cr0 = kUnset;
+  double drive_split_front = kUnset;
+  double brake_force_max = kUnset;
+  double brake_split_front = kUnset;
+  // load transfer
+  double pitch_time_constant = kUnset;
+  // actuators
+  double steering_max = kUnset;
+  double steering_rate_max = kUnset;
+  double steering_time_constant = kUnset;
+  double steering_dead_time = kUnset;
+  double throttle_time_constant = kUnset;
+  double brake_time_constant = kUnset;
+  // footprint for collisions (a rectangle in the base frame)
+  double front_overhang = kUnset;
+  double rear_overhang = kUnset;
+  double body_width = kUnset;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(mass), {"kg", params::above(0.0), "total mass of the car"});
+    v(PADDOCK_PARAM(inertia_z), {"kg m^2", params::above(0.0), "yaw moment of inertia about the CG"});
+    v(PADDOCK_PARAM(lf), {"m", params::above(0.0), "CG to front axle (along x)"});
+    v(PADDOCK_PARAM(lr), {"m", params::above(0.0), "CG to rear axle (along x)"});
+    v(PADDOCK_PARAM(h_cg), {"m", params::at_least(0.0), "CG height above ground (longitudinal load transfer)"});
+    v(PADDOCK_PARAM(track_front), {"m", params::above(0.0), "distance between the front contact patches"});
+    v(PADDOCK_PARAM(track_rear), {"m", params::above(0.0), "distance between the rear contact patches"});
+    v(PADDOCK_PARAM(wheel_radius), {"m", params::above(0.0), "dynamic rolling radius"});
+    v(PADDOCK_PARAM(tyre_b), {"1/rad", params::above(0.0), "Pacejka stiffness factor B"});
+    // C >= 2 would make the force change sign at large slip
+    v(PADDOCK_PARAM(tyre_c), {"", params::Bounds{0.0, 2.0, true, true}, "Pacejka shape factor C"});
+    v(PADDOCK_PARAM(tyre_d), {"", params::above(0.0), "Pacejka peak friction coefficient D (also the friction ellipse radius)"});
+    // E <= 1 keeps B a - E (B a - atan(B a)) increasing in a
+    v(PADDOCK_PARAM(tyre_e), {"", params::at_most(1.0), "Pacejka curvature factor E"});
+    v(PADDOCK_PARAM(c_down), {"N s^2/m^2", params::at_least(0.0), "downforce F = c_down vx^2"});
+    v(PADDOCK_PARAM(aero_balance_front), {"", params::fraction(), "share of the downforce on the front axle"});
+    v(PADDOCK_PARAM(c_drag), {"N s^2/m^2", params::at_least(0.0), "drag F = c_drag vx^2"});
+    v(PADDOCK_PARAM(cm1), {"N", params::at_least(0.0), "motor force at full throttle (all driven wheels)"});
+    v(PADDOCK_PARAM(cr0), {"N", params::at_least(0.0), "rolling resistance"});
+    v(PADDOCK_PARAM(drive_split_front), {"", params::fraction(), "share of the motor force on the front axle"});
+    v(PADDOCK_PARAM(brake_force_max), {"N", params::at_least(0.0), "total brake force at full brake"});
+    v(PADDOCK_PARAM(brake_split_front), {"", params::fraction(), "share of the brake force on the front axle (brake balance)"});
+    v(PADDOCK_PARAM(pitch_time_constant), {"s", params::above(0.0), "lag of the longitudinal load transfer behind the acceleration (pitch dynamics)"});
+    // below pi/2 so that tan(steering) of the kinematic model stays finite
+    v(PADDOCK_PARAM(steering_max), {"rad", params::above_up_to(0.0, 1.5), "road-wheel angle limit (symmetric)"});
+    v(PADDOCK_PARAM(steering_rate_max), {"rad/s", params::above(0.0), "road-wheel angle rate limit"});
+    v(PADDOCK_PARAM(steering_time_constant), {"s", params::at_least(0.0), "first-order lag of the steering actuator (< dt/2: instantaneous)"});
+    v(PADDOCK_PARAM(steering_dead_time), {"s", params::in(0.0, kMaxSteeringDeadTime), "pure delay on the steering command (rounded to whole steps)"});
+    v(PADDOCK_PARAM(throttle_time_constant), {"s", params::at_least(0.0), "first-order lag of the motor force (< dt/2: instantaneous)"});
+    v(PADDOCK_PARAM(brake_time_constant), {"s", params::at_least(0.0), "first-order lag of the brake force (< dt/2: instantaneous)"});
+    v(PADDOCK_PARAM(front_overhang), {"m", params::at_least(0.0), "front axle to the front of the car (nose, front wing)"});
+    v(PADDOCK_PARAM(rear_overhang), {"m", params::at_least(0.0), "rear axle to the back of the car"});
+    v(PADDOCK_PARAM(body_width), {"m", params::above(0.0), "overall width (tyres included)"});
+  }
+};
 
 // what the driver (the autonomy stack) asks for. Out-of-range values are limited;
 // non-finite ones are replaced by safe values (steering: hold, throttle 0, brake 1).

@@ -6,7 +6,6 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -64,32 +63,6 @@ double tipping_impulse(double base_width, double height, double mass, double hit
   // kinetic energy after the impulse: (J hit_height)^2 / (2 I_edge)
   const double lift = mass * kGravity * (rho - h_cm);
   return std::sqrt(2.0 * i_edge * lift) / hit_height;
-}
-
-std::string ConeWorldParams::check() const {
-  std::ostringstream err;
-  const auto spec_ok = [&err](const ConeSpec& s, const char* name) {
-    if (!(s.base_width > 0.0 && finite(s.base_width))) err << name << ".base_width must be > 0 m; ";
-    if (!(s.height > 0.0 && finite(s.height))) err << name << ".height must be > 0 m; ";
-    if (!(s.mass > 0.0 && finite(s.mass))) err << name << ".mass must be > 0 kg; ";
-    if (!(s.knock_impulse > 0.0 && finite(s.knock_impulse))) err << name << ".knock_impulse must be > 0 N s; ";
-  };
-  spec_ok(small_cone, "small_cone");
-  spec_ok(big_cone, "big_cone");
-  if (!(ground_friction >= 0.0 && finite(ground_friction))) err << "ground_friction must be >= 0; ";
-  if (!(car_cone_friction >= 0.0 && finite(car_cone_friction))) err << "car_cone_friction must be >= 0; ";
-  if (!(car_cone_restitution >= 0.0 && car_cone_restitution <= 1.0)) err << "car_cone_restitution must be in [0, 1]; ";
-  if (velocity_iterations < 1) err << "velocity_iterations must be >= 1; ";
-  if (position_iterations < 1) err << "position_iterations must be >= 1; ";
-  if (!(wake_margin > 0.0 && finite(wake_margin))) err << "wake_margin must be > 0 m; ";
-  if (!(world_margin >= wake_margin && finite(world_margin))) err << "world_margin must be >= wake_margin; ";
-  if (!(query_reach > wake_margin && finite(query_reach))) err << "query_reach must be > wake_margin; ";
-  if (!(rest_speed >= 0.0 && finite(rest_speed))) err << "rest_speed must be >= 0 m/s; ";
-  if (!(rest_spin >= 0.0 && finite(rest_spin))) err << "rest_spin must be >= 0 rad/s; ";
-  if (!(rest_time >= 0.0 && finite(rest_time))) err << "rest_time must be >= 0 s; ";
-  std::string s = err.str();
-  if (s.size() >= 2) s.resize(s.size() - 2);
-  return s;
 }
 
 struct ConeWorld::Impl : public b2ContactListener {
@@ -185,8 +158,7 @@ struct ConeWorld::Impl : public b2ContactListener {
 
 ConeWorld::Impl::Impl(std::vector<Cone> cones_in, const ConeWorldParams& p, const Footprint& fp)
     : params(p), footprint(fp), cones(std::move(cones_in)) {
-  const std::string bad = params.check();
-  if (!bad.empty()) throw std::invalid_argument("ConeWorldParams: " + bad);
+  params::require_valid(params, "ConeWorldParams");
   if (!(fp.rear + fp.front > 0.05 && fp.half_width > 0.05 && finite(fp.rear) && finite(fp.front) &&
         finite(fp.half_width))) {
     throw std::invalid_argument("Footprint: front + rear and half_width must be finite and > 0.05 m");

@@ -12,15 +12,24 @@
 
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
 
 namespace paddock::world {
 
 // one cone type. The sizes are the FS rule sizes (ORACLES.md "Cones and LiDAR").
 struct ConeSpec {
-  double base_width = 0.228;  // m, side of the square base (collision circle of radius base_width/2)
-  double height = 0.325;      // m
-  double mass = 0.9;          // kg
-  double knock_impulse = 1.5; // N s, a contact impulse above this in one step knocks the cone over
+  double base_width = 0.228;
+  double height = 0.325;
+  double mass = 0.9;
+  double knock_impulse = 1.5;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(base_width), {"m", params::above(0.0), "side of the square base (the collision circle's diameter)"});
+    v(PADDOCK_PARAM(height), {"m", params::above(0.0), "height"});
+    v(PADDOCK_PARAM(mass), {"kg", params::in(0.01, 100.0), "mass"});
+    v(PADDOCK_PARAM(knock_impulse), {"N s", params::above_up_to(0.0, 1000.0), "a contact impulse above this in one step knocks the cone over"});
+  }
 };
 
 // the smallest horizontal impulse (N s), applied at hit_height (m) above the
@@ -45,20 +54,18 @@ struct ConeWorldParams {
   // big orange cone: 285 x 285 x 505 mm, about 1.9 kg; tipping_impulse(0.285,
   // 0.505, 1.9, 0.10) = 4.71 N s, rounded to 4.7 N s (a speed change of 2.5 m/s).
   ConeSpec big_cone{0.285, 0.505, 1.9, 4.7};
-  // Coulomb friction coefficient of a cone base on asphalt (-): rubber/PVC on
-  // dry asphalt is 0.5-0.8; a sliding cone decelerates at ground_friction * g.
-  // Modelled by a b2FrictionJoint from each cone to the ground (max force
-  // mu m g, max torque mu m g times the base's mean radius): a constant
-  // deceleration and a definite stop after v^2 / (2 mu g). Linear damping would
-  // decay the speed exponentially (stopping distance v / c, never a stop).
+  // rubber/PVC on dry asphalt is 0.5-0.8; a sliding cone decelerates at
+  // ground_friction * g. Modelled by a b2FrictionJoint from each cone to the
+  // ground (max force mu m g, max torque mu m g times the base's mean radius):
+  // a constant deceleration and a definite stop after v^2 / (2 mu g). Linear
+  // damping would decay the speed exponentially (stopping distance v / c,
+  // never a stop).
   double ground_friction = 0.6;
   // contact between the car and a cone, and between two cones (same materials:
-  // PVC cone on carbon/plastic bodywork or on another cone). Friction (-) and
-  // restitution (-); impacts slower than 1 m/s are inelastic (Box2D's
-  // restitution threshold).
+  // PVC cone on carbon/plastic bodywork or on another cone); impacts slower
+  // than 1 m/s are inelastic (Box2D's restitution threshold).
   double car_cone_friction = 0.4;
   double car_cone_restitution = 0.2;
-  // Box2D solver iterations per step
   int velocity_iterations = 8;
   int position_iterations = 3;
 
@@ -68,20 +75,39 @@ struct ConeWorldParams {
   // is the same up to float rounding; false = plain Box2D: every cone a body,
   // a Box2D step every time, for tests and comparisons).
   bool skip_idle_steps = true;
-  // m, car-to-cone-edge clearance below which Box2D steps. The clearance bound
-  // is exact (it follows every footprint point), so this only has to cover
-  // float rounding: 2 cm.
+  // the clearance bound is exact (it follows every footprint point), so this
+  // only has to cover float rounding: 2 cm
   double wake_margin = 0.02;
-  double world_margin = 0.30; // m, clearance to the car or a moving cone within which a cone is a Box2D body
-  double query_reach = 2.0;   // m, how far around the car one proximity query looks
-  // a cone slower than rest_speed (m/s) and rest_spin (rad/s) with no touching
-  // contact for rest_time (s) is put to sleep (Box2D alone waits 0.5 s)
+  double world_margin = 0.30;
+  double query_reach = 2.0;
+  // a cone slower than rest_speed and rest_spin with no touching contact for
+  // rest_time is put to sleep (Box2D alone waits 0.5 s)
   double rest_speed = 0.01;
   double rest_spin = 0.035;
   double rest_time = 0.02;
 
-  // "" when every value is usable, otherwise what is wrong and what was expected
-  std::string check() const;
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(small_cone), "the small cone (blue, yellow, small orange, unknown)");
+    v.section(PADDOCK_PARAM(big_cone), "the big orange cone");
+    v(PADDOCK_PARAM(ground_friction), {"", params::in(0.0, 5.0), "Coulomb friction coefficient of a cone base on asphalt"});
+    v(PADDOCK_PARAM(car_cone_friction), {"", params::in(0.0, 5.0), "car-cone (and cone-cone) friction coefficient"});
+    v(PADDOCK_PARAM(car_cone_restitution), {"", params::fraction(), "car-cone (and cone-cone) restitution"});
+    v(PADDOCK_PARAM(velocity_iterations), {"", params::at_least(1), "Box2D velocity iterations per step"});
+    v(PADDOCK_PARAM(position_iterations), {"", params::at_least(1), "Box2D position iterations per step"});
+    v(PADDOCK_PARAM(skip_idle_steps), "skip Box2D steps while nothing can touch and keep only nearby cones as bodies (false: plain Box2D)");
+    v(PADDOCK_PARAM(wake_margin), {"m", params::above(0.0), "car-to-cone-edge clearance below which Box2D steps"});
+    v(PADDOCK_PARAM(world_margin), {"m", params::above(0.0), "clearance to the car or a moving cone within which a cone is a Box2D body"});
+    v(PADDOCK_PARAM(query_reach), {"m", params::above(0.0), "how far around the car one proximity query looks"});
+    v(PADDOCK_PARAM(rest_speed), {"m/s", params::at_least(0.0), "a cone slower than this (and rest_spin) may go to sleep"});
+    v(PADDOCK_PARAM(rest_spin), {"rad/s", params::at_least(0.0), "a cone spinning slower than this (and rest_speed) may go to sleep"});
+    v(PADDOCK_PARAM(rest_time), {"s", params::at_least(0.0), "time at rest without a touching contact before a cone sleeps"});
+  }
+  std::string check() const {
+    if (!(world_margin >= wake_margin)) return "world_margin must be >= wake_margin";
+    if (!(query_reach > wake_margin)) return "query_reach must be > wake_margin";
+    return "";
+  }
 };
 
 // the car's outline in its base frame (origin at the rear axle centre, x
@@ -111,7 +137,7 @@ struct ConeWorldStats {
 
 class ConeWorld {
  public:
-  // throws std::invalid_argument when params.check() fails or the footprint is
+  // throws std::invalid_argument when params::validate(params) fails or the footprint is
   // degenerate (front + rear and half_width must exceed 5 cm) or a cone
   // position is not finite. Every cone starts asleep at its given position.
   ConeWorld(std::vector<Cone> cones, const ConeWorldParams& params, const Footprint& footprint);

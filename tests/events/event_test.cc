@@ -33,6 +33,13 @@ void cross(Event& e, double t, double gate_x = 0.0) {
   e.on_motion(t - 0.005, {gate_x - 0.05, 0.0}, t + 0.005, {gate_x + 0.05, 0.0});
 }
 
+TEST(EventParams, DefaultsAreValidAndABadValueIsNamed) {
+  EXPECT_EQ(params::validate(EventParams{}), "");
+  EventParams p;
+  p.stall_time = 0.0;
+  EXPECT_EQ(params::validate(p), "stall_time must be in [0.1, 600] s (got 0)");
+}
+
 TEST(Event, LapTimesAreInterpolatedGateToGate) {
   const auto track = strip_track();
   Event e(EventKind::Autocross, track, EventParams{});

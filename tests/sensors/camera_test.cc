@@ -96,17 +96,18 @@ TEST(Camera, CalibrationMatchesHandComputedIntrinsicsAndMount) {
 TEST(Camera, RejectsBadParams) {
   CameraParams p;
   p.width = 4;
-  EXPECT_NE(validate(p).find("width"), std::string::npos);
+  EXPECT_EQ(params::validate(p), "width must be in [16, 8192] px (got 4)");
   p = CameraParams{};
   p.hfov = 3.2;
-  EXPECT_NE(validate(p).find("hfov"), std::string::npos);
+  EXPECT_EQ(params::validate(p).rfind("hfov must be in [", 0), 0u) << params::validate(p);
   p = CameraParams{};
   p.blue.b = 1.5;
-  EXPECT_NE(validate(p).find("blue"), std::string::npos);
+  EXPECT_EQ(params::validate(p), "blue.b must be in [0, 1] (got 1.5)");
   p = CameraParams{};
   p.mount_z = 0.0;
+  EXPECT_EQ(params::validate(p), "mount_z must be in [0.01, 5] m (got 0)");
   EXPECT_THROW(Camera(p, 1), std::invalid_argument);
-  EXPECT_EQ(validate(CameraParams{}), "");
+  EXPECT_EQ(params::validate(CameraParams{}), "");
 }
 
 TEST(Camera, SingleConeSitsWhereItsCentreProjects) {

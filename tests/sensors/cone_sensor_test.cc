@@ -41,11 +41,11 @@ bool less_xy(const hal::DetectedCone& a, const hal::DetectedCone& b) {
   return a.position.x < b.position.x || (a.position.x == b.position.x && a.position.y < b.position.y);
 }
 
-TEST(ConeSensorParams, DefaultsAreValid) { EXPECT_EQ(validate(ConeSensorParams{}), ""); }
+TEST(ConeSensorParams, DefaultsAreValid) { EXPECT_EQ(params::validate(ConeSensorParams{}), ""); }
 
 TEST(ConeSensorParams, ValidateNamesTheField) {
   auto first_word = [](const ConeSensorParams& p) {
-    const std::string msg = validate(p);
+    const std::string msg = params::validate(p);
     return msg.substr(0, msg.find(' '));
   };
   ConeSensorParams p;
@@ -72,6 +72,12 @@ TEST(ConeSensorParams, ValidateNamesTheField) {
   p = {};
   p.false_positives_per_frame = -1.0;
   EXPECT_EQ(first_word(p), "false_positives_per_frame");
+  p = {};
+  p.small_cone_radius = 0.0;  // set by the runner, not visited: check() has it
+  EXPECT_EQ(params::validate(p), "small_cone_radius must be > 0 m (got 0)");
+  EXPECT_THROW(ConeSensor(p, 1), std::invalid_argument);
+  p = {};
+  p.false_positives_per_frame = -1.0;
   EXPECT_THROW(ConeSensor(p, 1), std::invalid_argument);
   EXPECT_NO_THROW(ConeSensor(ConeSensorParams{}, 1));
 }

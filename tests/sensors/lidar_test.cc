@@ -542,7 +542,7 @@ P3 to_world_on(const LidarPoint& q, const Pose2& base, const LidarParams& p,
 TEST(LidarGround, HeightFieldFormulaAndValidation) {
   GroundParams g;
   EXPECT_TRUE(flat(g));
-  EXPECT_EQ(validate(g), "");
+  EXPECT_EQ(params::validate(g), "");
   EXPECT_DOUBLE_EQ(ground_height(g, 3.0, -7.0), 0.0);
   g.slope_x = 0.1;
   g.slope_y = -0.05;
@@ -556,14 +556,14 @@ TEST(LidarGround, HeightFieldFormulaAndValidation) {
   EXPECT_NEAR(ground_height(g, 4.0, 1.0), 0.0, 1e-12);
   GroundParams bad;
   bad.cell = 0.0;
-  EXPECT_NE(validate(bad).find("cell"), std::string::npos);
+  EXPECT_EQ(params::validate(bad), "cell must be in [0.01, 100] m (got 0)");
   EXPECT_THROW(LidarWorld({}, {}, bad), std::invalid_argument);
   bad = GroundParams{};
   bad.bump_wavelength = -1.0;
-  EXPECT_NE(validate(bad).find("bump_wavelength"), std::string::npos);
+  EXPECT_EQ(params::validate(bad), "bump_wavelength must be in [0.1, 1000] m (got -1)");
   bad = GroundParams{};
   bad.slope_x = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_NE(validate(bad).find("slope"), std::string::npos);
+  EXPECT_EQ(params::validate(bad).rfind("slope_x must be in [-1, 1]", 0), 0u) << params::validate(bad);
   // flat: the two-triangle fast path
   LidarWorld flat_world({Cone{{5.0, 0.0}, ConeColor::Blue}});
   EXPECT_EQ(flat_world.ground_triangles(), 2u);

@@ -10,12 +10,23 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace paddock::vehicle {
 namespace {
 
 constexpr double kDt = 1e-3;  // s, the simulator's physics step
+
+// the fields of p in the order its visit() lists them, by name
+std::vector<std::pair<std::string, double*>> fields_of(VehicleParams& p) {
+  struct Lister {
+    std::vector<std::pair<std::string, double*>> fields;
+    void operator()(const char* key, double& field, const params::Spec&) { fields.emplace_back(key, &field); }
+  } lister;
+  p.visit(lister);
+  return lister.fields;
+}
 
 // a minimal reader of scenarios/vehicles/default.ini (the real scenario parser lives in
 // sim/runner): one [vehicle] section, `key = value ; comment` lines; every key must be a
@@ -25,6 +36,7 @@ VehicleParams load_default_params() {
   std::ifstream f(path);
   EXPECT_TRUE(f.good()) << "cannot open " << path;
   VehicleParams p;
+  const auto fields = fields_of(p);
   std::set<std::string> seen;
   std::string line, section;
   int lineno = 0;
@@ -46,18 +58,18 @@ VehicleParams load_default_params() {
     key.erase(key.find_last_not_of(" \t") + 1);
     const std::string value = line.substr(eq + 1);
     bool known = false;
-    for (const ParamField& field : param_fields()) {
-      if (key == field.name) {
+    for (const auto& [name, field] : fields) {
+      if (key == name) {
         known = true;
         std::size_t used = 0;
-        p.*field.member = std::stod(value, &used);
+        *field = std::stod(value, &used);
         EXPECT_EQ(value.find_first_not_of(" \t", used), std::string::npos) << path << ":" << lineno;
       }
     }
     EXPECT_TRUE(known) << path << ":" << lineno << ": unknown key " << key;
     EXPECT_TRUE(seen.insert(key).second) << path << ":" << lineno << ": duplicate key " << key;
   }
-  EXPECT_EQ(seen.size(), param_fields().size()) << "default.ini must set every field";
+  EXPECT_EQ(seen.size(), fields.size()) << "default.ini must set every field";
   return p;
 }
 
@@ -116,9 +128,22 @@ void expect_states_equal(const VehicleState& a, const VehicleState& b) {
 // parameters
 // ---------------------------------------------------------------------------
 
+TEST(VehicleParams, TheVisitListsEveryFieldOnce) {
+  // every member is a double: the visit must list as many distinct fields
+  VehicleParams p;
+  const auto fields = fields_of(p);
+  EXPECT_EQ(fields.size(), sizeof(VehicleParams) / sizeof(double));
+  std::set<std::string> names;
+  std::set<const double*> members;
+  for (const auto& [name, field] : fields) {
+    EXPECT_TRUE(names.insert(name).second) << name << " listed twice";
+    EXPECT_TRUE(members.insert(field).second) << name << " is another field's member";
+  }
+}
+
 TEST(VehicleParams, DefaultIniSetsEveryFieldAndValidates) {
   const VehicleParams& p = defaults();
-  EXPECT_EQ(validate(p), "");
+  EXPECT_EQ(params::validate(p), "");
   // the ORACLES.md gotthard figures
   EXPECT_EQ(p.mass, 190.0);
   EXPECT_EQ(p.inertia_z, 110.0);
@@ -130,23 +155,27 @@ TEST(VehicleParams, DefaultIniSetsEveryFieldAndValidates) {
 TEST(VehicleParams, ValidateNamesTheFieldAndWhatWasExpected) {
   VehicleParams p = defaults();
   p.mass = -1.0;
-  EXPECT_EQ(validate(p), "mass must be > 0 kg (got -1)");
+  EXPECT_EQ(params::validate(p), "mass must be > 0 kg (got -1)");
 
   p = defaults();
   p.aero_balance_front = 1.5;
-  EXPECT_EQ(validate(p), "aero_balance_front must be in [0, 1] (got 1.5)");
+  EXPECT_EQ(params::validate(p), "aero_balance_front must be in [0, 1] (got 1.5)");
 
   p = defaults();
   p.steering_dead_time = 2.0;
-  EXPECT_EQ(validate(p).rfind("steering_dead_time must be in [0, 0.25] s", 0), 0u) << validate(p);
+  EXPECT_EQ(params::validate(p), "steering_dead_time must be in [0, 0.25] s (got 2)");
+
+  p = defaults();
+  p.tyre_c = 2.0;  // open upper end
+  EXPECT_EQ(params::validate(p), "tyre_c must be in (0, 2) (got 2)");
 
   // a field left unset (NaN) is named
   p = defaults();
   p.brake_force_max = kUnset;
-  EXPECT_EQ(validate(p).rfind("brake_force_max must be set", 0), 0u) << validate(p);
+  EXPECT_EQ(params::validate(p), "brake_force_max must be >= 0 N (got nan)");
 
   // a default-constructed set is rejected at its first field
-  EXPECT_EQ(validate(VehicleParams{}).rfind("mass ", 0), 0u);
+  EXPECT_EQ(params::validate(VehicleParams{}), "mass must be > 0 kg (got nan)");
 }
 
 // ---------------------------------------------------------------------------

@@ -54,7 +54,7 @@ std::vector<Cone> lane() {
 
 TEST(ConeWorld, DefaultKnockImpulsesAreTheTippingImpulses) {
   const ConeWorldParams p;
-  EXPECT_EQ(p.check(), "");
+  EXPECT_EQ(params::validate(p), "");
   // a hit 0.10 m above the ground (FS front wing end plate / nose)
   EXPECT_NEAR(tipping_impulse(0.228, 0.325, 0.9, 0.10), 1.5431, 1e-3);
   EXPECT_NEAR(tipping_impulse(0.285, 0.505, 1.9, 0.10), 4.7108, 1e-3);
@@ -67,7 +67,14 @@ TEST(ConeWorld, DefaultKnockImpulsesAreTheTippingImpulses) {
 TEST(ConeWorld, RejectsBadParamsAndFootprint) {
   ConeWorldParams bad;
   bad.ground_friction = -0.1;
-  EXPECT_NE(bad.check().find("ground_friction"), std::string::npos);
+  EXPECT_EQ(params::validate(bad), "ground_friction must be in [0, 5] (got -0.1)");
+  EXPECT_THROW(ConeWorld(lane(), bad, kCar), std::invalid_argument);
+  bad = ConeWorldParams{};
+  bad.big_cone.knock_impulse = 0.0;
+  EXPECT_EQ(params::validate(bad), "big_cone.knock_impulse must be in (0, 1000] N s (got 0)");
+  bad = ConeWorldParams{};
+  bad.world_margin = 0.01;  // inside wake_margin
+  EXPECT_EQ(params::validate(bad), "world_margin must be >= wake_margin");
   EXPECT_THROW(ConeWorld(lane(), bad, kCar), std::invalid_argument);
   EXPECT_THROW(ConeWorld(lane(), ConeWorldParams{}, Footprint{0.0, 0.0, 0.7}), std::invalid_argument);
   std::vector<Cone> nan_cone{{{std::nan(""), 0.0}, ConeColor::Blue}};
