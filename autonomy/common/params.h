@@ -7,7 +7,7 @@
 //     v(PADDOCK_PARAM(tolerance), {"m", params::above(0.0), "points closer than this join one cluster"});
 //     v(PADDOCK_PARAM(min_points), {"", params::at_least(1), "smaller clusters are dropped"});
 //     v(PADDOCK_PARAM(method), kMethodNames, "how the centreline is smoothed");  // an enum
-//     v(PADDOCK_PARAM(occlusion), "cones hide the cones behind them");              // a bool
+//     v(PADDOCK_PARAM(occlusion), "cones hide the cones behind them");              // a bool (or optional bool)
 //     v.section(PADDOCK_PARAM(ground), "the ground segmentation");                  // a nested Params
 //   }
 //
@@ -134,6 +134,7 @@ class Validator {
     problem_ = prefix_ + key + " has a value that is not one of its names";
   }
   void operator()(const char*, bool&, const char*) {}
+  void operator()(const char*, std::optional<bool>&, const char*) {}
   void operator()(const char*, std::string&, const char*) {}
 
   template <class P>

@@ -10,6 +10,7 @@
 #include "sim/runner/reports.h"
 #include "sim/runner/report.h"
 #include "sim/runner/scenario.h"
+#include "sim/runner/schema.h"
 #include "sim/runner/simulation.h"
 #include "sim/world/track.h"
 
@@ -34,6 +35,9 @@ const char* kUsage =
     "      Table I of the paper: the scenario with each lateral controller, as Markdown\n"
     "  paddock report smoothing TRACK.csv\n"
     "      Table II of the paper: four smoothings of the track's planned centreline\n"
+    "  paddock keys\n"
+    "      every scenario key (section = struct path) with its default, unit, range and\n"
+    "      meaning, as the README's Markdown table\n"
     "  paddock check-track FILE...\n"
     "      loads, validates and describes track CSV files\n";
 
@@ -197,6 +201,11 @@ int run_cli(const std::vector<std::string>& args) {
     if (args[0] == "check-track") return cmd_check_track(rest);
     if (args[0] == "plot") return cmd_plot(rest);
     if (args[0] == "report") return cmd_report(rest);
+    if (args[0] == "keys") {
+      if (!rest.empty()) throw UserError("keys takes no arguments\n" + std::string(kUsage));
+      std::cout << keys_markdown();
+      return 0;
+    }
     throw UserError("unknown command '" + args[0] + "'\n" + kUsage);
   } catch (const std::exception& e) {
     // user errors (and track errors) carry their file:line already

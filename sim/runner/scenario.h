@@ -19,24 +19,53 @@
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
 #include "sim/world/track.h"
+#include "autonomy/common/params.h"
 #include "sim/runner/schema.h"
 
 namespace paddock::runner {
 
 // [scenario]
 struct ScenarioSection {
-  std::string track;                                  // track CSV, relative to the file that names it
+  // relative to the file that names it; the resolved scenario writes it absolute
+  std::string track;
   events::EventKind event = events::EventKind::Trackdrive;
-  std::uint64_t seed = 1;                             // every random draw of the run derives from it
-  double go_time = 5.0;                               // s in AS Ready before the go signal (rules: at least 5 s)
+  // every random draw of the run derives from it (stream_seed)
+  std::uint64_t seed = 1;
+  // the rules ask for at least 5 s in AS Ready
+  double go_time = 5.0;
+
+  static constexpr params::Choice<events::EventKind> kEvents[] = {{"trackdrive", events::EventKind::Trackdrive},
+                                                                  {"autocross", events::EventKind::Autocross},
+                                                                  {"acceleration", events::EventKind::Acceleration},
+                                                                  {"skidpad", events::EventKind::Skidpad}};
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(track), "the track CSV file, relative to the file that names it (required)");
+    v(PADDOCK_PARAM(event), kEvents, "the FS event and its rules");
+    v(PADDOCK_PARAM(seed), {"", params::in(0, 9.2e18), "the run's random seed (every random draw derives from it)"});
+    v(PADDOCK_PARAM(go_time), {"s", params::in(0.0, 600.0), "time in AS Ready before the go signal"});
+  }
 };
 
 // [sim]
 struct SimSection {
-  int physics_rate = 1000;  // Hz, vehicle and world integration
-  int control_rate = 100;   // Hz, the stack's cycle (and the state estimate's rate)
-  int log_rate = 100;       // Hz, rows of log.csv; also the rate of the off-course test
-  double snapshot_time = 12.0;  // s: the first scan after this is kept for the perception figures
+  int physics_rate = 1000;
+  int control_rate = 100;
+  int log_rate = 100;
+  double snapshot_time = 12.0;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(physics_rate), {"Hz", params::in(1, 100000), "vehicle and world integration rate"});
+    v(PADDOCK_PARAM(control_rate), {"Hz", params::in(1, 100000), "the stack's cycle (and the state estimate's rate)"});
+    v(PADDOCK_PARAM(log_rate), {"Hz", params::in(1, 100000), "rows of log.csv, and the event's off-course checks"});
+    v(PADDOCK_PARAM(snapshot_time), {"s", params::in(0.0, 1e6), "the first LiDAR scan after this is kept for the perception figures"});
+  }
+  std::string check() const {
+    return physics_rate % control_rate == 0 && physics_rate % log_rate == 0
+               ? ""
+               : "physics_rate must be a whole multiple of control_rate and log_rate";
+  }
 };
 
 // [expect]: what a CI scenario must achieve; unset entries are not checked
@@ -46,42 +75,89 @@ struct Expectations {
   std::optional<int> doo_max;
   std::optional<int> oc_max;
   std::optional<int> uss_max;
-  std::optional<double> lap_time_max;        // s, every completed lap
-  std::optional<double> lap_time_min;        // s, every completed lap
-  std::optional<double> total_time_max;      // s, penalised
-  std::optional<double> lateral_rms_max;     // m
-  std::optional<double> lateral_error_max;   // m
-  std::optional<int> fallbacks_max;          // control cycles in the safe stop
+  std::optional<double> lap_time_max;
+  std::optional<double> lap_time_min;
+  std::optional<double> total_time_max;
+  std::optional<double> lateral_rms_max;
+  std::optional<double> lateral_error_max;
+  std::optional<int> fallbacks_max;
+
+  template <class V>
+  void visit(V& v) {
+    const params::Bounds count = params::in(0, 1000000), positive = params::at_least(0.0);
+    v(PADDOCK_PARAM(finished), "the run finishes");
+    v(PADDOCK_PARAM(laps), {"", count, "completed laps"});
+    v(PADDOCK_PARAM(doo_max), {"", count, "cones down or out, at most"});
+    v(PADDOCK_PARAM(oc_max), {"", count, "off-course excursions, at most"});
+    v(PADDOCK_PARAM(uss_max), {"", count, "unsafe stops, at most"});
+    v(PADDOCK_PARAM(lap_time_max), {"s", positive, "every lap at most"});
+    v(PADDOCK_PARAM(lap_time_min), {"s", positive, "every lap at least"});
+    v(PADDOCK_PARAM(total_time_max), {"s", positive, "penalised time at most"});
+    v(PADDOCK_PARAM(lateral_rms_max), {"m", positive, "RMS lateral error at most"});
+    v(PADDOCK_PARAM(lateral_error_max), {"m", positive, "largest lateral error at most"});
+    v(PADDOCK_PARAM(fallbacks_max), {"", count, "safe-stop control cycles, at most"});
+  }
 };
 
+// the whole tree. Its sections are its members, in this order; a nested
+// Params struct is a section of its own ([perception.lidar.clustering])
 struct Scenario {
-  std::string source;   // the file it was read from
-  std::string name;     // its stem
+  std::string source;      // the file it was read from
+  std::string name;        // its stem
   std::string track_path;  // [scenario] track resolved against the naming file's folder
 
   ScenarioSection scenario;
   stack::AutonomyModes autonomy;
-  sensors::ConeSensorParams cone_sensor;  // [cone_sensor]: the object-level sensor of perception = ground_truth
-  sensors::ImuParams imu;                 // [imu]
-  sensors::WheelSpeedParams wheel_speeds;  // [wheel_speeds]
-  sensors::SteeringSensorParams steering_sensor;  // [steering_sensor]
-  sensors::LidarParams lidar;             // [lidar]: the rotating LiDAR of perception = lidar, lidar_camera
-  sensors::CameraParams camera;           // [camera]: the camera of perception = lidar_camera
-  sensors::DetectorParams detector;       // [detector]: the camera's detector node (its error model)
-  // [perception]: the stack's perception front (perception = lidar |
-  // lidar_camera); its calibration is filled from [lidar] and [camera]
-  perception::PerceptionParams perception;
-  sensors::GroundParams ground;           // [ground]: the ground's shape, as the sensors see it
+  // the car and the world
   vehicle::VehicleParams vehicle;
-  control::ControlParams control;
+  world::ConeWorldParams cones;
+  sensors::GroundParams ground;
+  events::EventParams event;
+  // the sensors
+  sensors::ConeSensorParams cone_sensor;
+  sensors::LidarParams lidar;
+  sensors::CameraParams camera;
+  sensors::DetectorParams detector;
+  sensors::ImuParams imu;
+  sensors::WheelSpeedParams wheel_speeds;
+  sensors::SteeringSensorParams steering_sensor;
+  // the stack (stack_params adds what it knows of the car and its sensors)
+  perception::PerceptionParams perception;
+  slam::ConeMapParams cone_map;
   planning::PathPlannerParams planning;
   planning::SkidpadParams skidpad;
+  control::ControlParams control;
   stack::MissionParams mission;
-  slam::ConeMapParams cone_map;  // [slam]: the cone map of slam = ground_truth
-  world::ConeWorldParams cones;
-  events::EventParams event;
+  stack::GateParams gates;
+  // the simulation itself, and what a CI run must achieve
   SimSection sim;
   Expectations expect;
+
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(scenario), "the event, its track and the run's seed");
+    v.section(PADDOCK_PARAM(autonomy), "where each layer of the stack gets its input: the real module or ground truth");
+    v.section(PADDOCK_PARAM(vehicle), "every physical parameter of the car, all required: include = vehicles/default.ini");
+    v.section(PADDOCK_PARAM(cones), "the cones' physics (Box2D): masses, knock-over impulses, frictions");
+    v.section(PADDOCK_PARAM(ground), "the ground the sensors see (the vehicle model stays planar)");
+    v.section(PADDOCK_PARAM(event), "the event's limits: timeout, stop, off-track and stall times");
+    v.section(PADDOCK_PARAM(cone_sensor), "the object-level cone sensor of perception = ground_truth");
+    v.section(PADDOCK_PARAM(lidar), "the rotating LiDAR of perception = lidar | lidar_camera");
+    v.section(PADDOCK_PARAM(camera), "the camera the LiDAR triggers (perception = lidar_camera)");
+    v.section(PADDOCK_PARAM(detector), "the camera's detector node: the error model of a network (misses, confusions, box jitter)");
+    v.section(PADDOCK_PARAM(imu), "the inertial measurement unit");
+    v.section(PADDOCK_PARAM(wheel_speeds), "the four wheel-speed sensors");
+    v.section(PADDOCK_PARAM(steering_sensor), "the steering-angle sensor");
+    v.section(PADDOCK_PARAM(perception), "the stack's perception front (perception = lidar | lidar_camera)");
+    v.section(PADDOCK_PARAM(cone_map), "the stack's cone map");
+    v.section(PADDOCK_PARAM(planning), "the stack's path planner (planner = delaunay) and reference trajectory");
+    v.section(PADDOCK_PARAM(skidpad), "the stack's skidpad mission");
+    v.section(PADDOCK_PARAM(control), "the stack's controllers");
+    v.section(PADDOCK_PARAM(mission), "the stack's mission logic");
+    v.section(PADDOCK_PARAM(gates), "the timekeeping gates the stack learns from big orange cones");
+    v.section(PADDOCK_PARAM(sim), "the simulation's rates");
+    v.section(PADDOCK_PARAM(expect), "what a CI scenario must achieve (unset entries are not checked)");
+  }
 };
 
 // reads, resolves includes, applies the overrides ("section.key=value"), checks

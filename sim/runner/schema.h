@@ -1,38 +1,60 @@
 #pragma once
-// the scenario's keys: each one's section, name, unit, range and where it
-// lands in the Scenario struct. One table (scenario.cc) drives reading,
-// validation and writing back.
+// the scenario's keys, generated from the Params structs' own declarations
+// (autonomy/common/params.h): Scenario::visit names its sections, each
+// Params struct its fields. A key's section is the struct path
+// ("perception.lidar.clustering"), its name the field's ("tolerance"); its
+// unit, bounds and meaning are the field's declaration. The loader, --set,
+// the resolved scenario.ini, validation and `paddock keys` (the README's
+// table) all read this one list.
 #include <functional>
 #include <string>
-#include <utility>
 #include <vector>
 
+#include "autonomy/common/params.h"
 #include "sim/runner/ini.h"
 
 namespace paddock::runner {
 
 struct Scenario;
 
-struct Field {
-  std::string section;
-  std::string key;
-  std::string unit;  // SI unit of the stored value ("" for none)
+// one key of one Scenario, bound to its field
+struct Key {
+  std::string section;  // the struct path, e.g. "perception.lidar.clustering"
+  std::string name;     // the field, e.g. "tolerance"
+  std::string unit;     // SI unit of the stored value ("" for none)
+  std::string expected;  // what a value must be: "> 0 m", "one of: a, b", "true or false", ...
   std::string doc;
-  bool required = false;  // no default: must be given (the [vehicle] keys)
-  // parses e.value into the scenario; throws UserError "file:line: ..."
-  std::function<void(Scenario&, const IniEntry& e)> set;
-  // the stored value as INI text ("" when an optional value is unset)
-  std::function<std::string(const Scenario&)> get;
+  bool required = false;  // no default in code (a NaN: the [vehicle] keys)
+  params::Bounds bounds;  // a number's bounds (any for other kinds)
+  bool integer = false;   // a whole number
+  // parses e.value into the field; throws UserError "file:line: ..."
+  std::function<void(const IniEntry& e)> set;
+  // the field's value as INI text ("" when an optional value is unset)
+  std::function<std::string()> get;
+
+  std::string path() const { return section + "." + name; }
 };
+
+// a section's meaning, from the declaration of the struct it is
+struct SectionDoc {
+  std::string section;
+  std::string doc;
+};
+
+// every key of s, bound to s's fields, in declaration order; s must outlive them
+std::vector<Key> scenario_keys(Scenario& s);
+// every section (with its meaning), in declaration order
+std::vector<SectionDoc> scenario_sections();
+
+// the README's table of every section and key (Markdown): section, key,
+// default, unit, what a value must be, meaning; `paddock keys` prints it
+std::string keys_markdown();
 
 // a number with an optional unit after it ("25 deg", "90 km/h", "0.5"); a bare
 // number is in `unit`; other units convert when they measure the same thing;
-// the result must lie in [lo, hi]; throws UserError "file:line: ..."
-double parse_quantity(const IniEntry& e, const std::string& unit, double lo, double hi);
-long parse_integer(const IniEntry& e, long lo, long hi);
+// the result must lie in `bounds`; throws UserError "file:line: ..."
+double parse_quantity(const IniEntry& e, const std::string& unit, const params::Bounds& bounds);
+long parse_integer(const IniEntry& e, const params::Bounds& bounds);
 bool parse_bool(const IniEntry& e);
-
-// every key of the scenario, in the order the resolved file lists them
-const std::vector<Field>& scenario_fields();
 
 }  // namespace paddock::runner

@@ -8,35 +8,6 @@
 
 namespace paddock::sensors {
 
-namespace {
-
-bool unit(double v) { return finite(v) && v >= 0.0 && v <= 1.0; }
-
-}  // namespace
-
-std::string validate(const DetectorParams& p) {
-  std::ostringstream os;
-  if (!unit(p.p_miss_near)) {
-    os << "p_miss_near must be in [0, 1] (got " << p.p_miss_near << ")";
-  } else if (!finite(p.range_full) || !(p.range_full >= 0.0)) {
-    os << "range_full must be finite and >= 0 m (got " << p.range_full << ")";
-  } else if (!finite(p.range_max) || !(p.range_max > p.range_full)) {
-    os << "range_max must be finite and > range_full (got " << p.range_max << " <= " << p.range_full << ")";
-  } else if (!unit(p.visible_min)) {
-    os << "visible_min must be in [0, 1] (got " << p.visible_min << ")";
-  } else if (!unit(p.visible_full) || !(p.visible_full >= p.visible_min)) {
-    os << "visible_full must be in [visible_min, 1] (got " << p.visible_full << ")";
-  } else if (!unit(p.p_confuse_blue_yellow)) {
-    os << "p_confuse_blue_yellow must be in [0, 1] (got " << p.p_confuse_blue_yellow << ")";
-  } else if (!unit(p.p_confuse_orange_size)) {
-    os << "p_confuse_orange_size must be in [0, 1] (got " << p.p_confuse_orange_size << ")";
-  } else if (!finite(p.box_jitter) || !(p.box_jitter >= 0.0)) {
-    os << "box_jitter must be finite and >= 0 (got " << p.box_jitter << ")";
-  } else if (!finite(p.min_box_height) || !(p.min_box_height >= 0.0)) {
-    os << "min_box_height must be finite and >= 0 px (got " << p.min_box_height << ")";
-  }
-  return os.str();
-}
 
 double miss_probability(const DetectorParams& p, double range, double visible_fraction) {
   if (!finite(range) || !finite(visible_fraction)) return 1.0;
@@ -120,8 +91,7 @@ std::vector<TightBox> tight_boxes(const hal::CameraFrame& f, const CameraAnnotat
 
 AnnotationDetector::AnnotationDetector(const DetectorParams& params, std::uint64_t seed)
     : params_(params), rng_(seed) {
-  const std::string err = validate(params_);
-  if (!err.empty()) throw std::invalid_argument("DetectorParams: " + err);
+  params::require_valid(params_, "DetectorParams");
 }
 
 AnnotationDetection AnnotationDetector::detect(const hal::CameraFrame& frame, const CameraAnnotation& annotation) {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/common/params.h"
 #include "autonomy/hal/messages.h"
 #include "sim/sensors/camera.h"
 
@@ -47,28 +48,41 @@ namespace paddock::sensors {
 // reliable detection to 15-20 m on ~1 MP images); the curve below gives 2 %
 // to 12 m, 9.3 % at 15 m, 43 % at 20 m, 1 at 30 m.
 struct DetectorParams {
-  double p_miss_near = 0.02;  // -, in [0, 1]
-  double range_full = 12.0;   // m, >= 0
-  double range_max = 30.0;    // m, > range_full
+  double p_miss_near = 0.02;
+  double range_full = 12.0;
+  double range_max = 30.0;
   // a cone less than 30 % visible is not found, one 70 % visible always is
   // (as far as occlusion goes): YOLO finds well-separated half-hidden cones
   // about half the time
-  double visible_min = 0.3;   // -, in [0, 1]
-  double visible_full = 0.7;  // -, in [visible_min, 1], > visible_min unless both 1
+  double visible_min = 0.3;
+  double visible_full = 0.7;
   // blue and yellow look alike in low light / against the sun; the two
   // oranges differ mainly in size
-  double p_confuse_blue_yellow = 0.01;  // -, in [0, 1]
-  double p_confuse_orange_size = 0.05;  // -, in [0, 1]
-  // box edge noise std, as a fraction of the box's size (3 %: about a pixel
-  // on a 30 px cone, YOLO's typical IoU of 0.85-0.9 on cones)
-  double box_jitter = 0.03;  // -, >= 0
-  // boxes smaller than this are never found (YOLOv5's smallest anchors)
-  double min_box_height = 6.0;  // px, >= 0
-};
+  double p_confuse_blue_yellow = 0.01;
+  double p_confuse_orange_size = 0.05;
+  // 3 %: about a pixel on a 30 px cone, YOLO's typical IoU of 0.85-0.9 on cones
+  double box_jitter = 0.03;
+  // YOLOv5's smallest anchors
+  double min_box_height = 6.0;
 
-// "" when every field is usable, else the first problem, starting with the
-// field name
-std::string validate(const DetectorParams& p);
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(p_miss_near), {"", params::fraction(), "chance of missing an unoccluded cone up to range_full"});
+    v(PADDOCK_PARAM(range_full), {"m", params::at_least(0.0), "misses start to grow beyond this"});
+    v(PADDOCK_PARAM(range_max), {"m", params::above(0.0), "every cone is missed beyond this"});
+    v(PADDOCK_PARAM(visible_min), {"", params::fraction(), "a cone less visible than this is always missed"});
+    v(PADDOCK_PARAM(visible_full), {"", params::fraction(), "occlusion adds no misses above this visible share"});
+    v(PADDOCK_PARAM(p_confuse_blue_yellow), {"", params::fraction(), "chance of calling blue yellow or yellow blue"});
+    v(PADDOCK_PARAM(p_confuse_orange_size), {"", params::fraction(), "chance of calling a small orange big or a big one small"});
+    v(PADDOCK_PARAM(box_jitter), {"", params::fraction(), "std of each box edge as a share of the box size"});
+    v(PADDOCK_PARAM(min_box_height), {"px", params::at_least(0.0), "smaller boxes are never found"});
+  }
+  std::string check() const {
+    if (!(range_max > range_full)) return "range_max must be > range_full";
+    if (!(visible_full >= visible_min)) return "visible_full must be >= visible_min";
+    return "";
+  }
+};
 
 // p_miss of the model above, for an instance at `range` (m) with
 // `visible_fraction` (-) visible

@@ -10,6 +10,8 @@
 #include <fstream>
 
 #include "sim/runner/files.h"
+#include "sim/runner/ini.h"
+#include "sim/runner/schema.h"
 
 namespace paddock::runner {
 namespace {
@@ -60,10 +62,10 @@ TEST(Scenario, DefaultLoadsWithTheVehicleFile) {
 }
 
 TEST_F(ScenarioFile, UnknownKeyNamesFileLineAndTheKnownKeys) {
-  const auto p = write(std::string(kHead) + "[control]\nlateral = combined\nstanly_k = 2\n");
+  const auto p = write(std::string(kHead) + "[control.stanley]\nk = 2\nk_sof = 2\n");
   const auto msg = error_of(p);
-  EXPECT_THAT(msg, HasSubstr(p + ":6: unknown key 'stanly_k' in [control]"));
-  EXPECT_THAT(msg, HasSubstr("stanley_k"));
+  EXPECT_THAT(msg, HasSubstr(p + ":6: unknown key 'k_sof' in [control.stanley]; expected one of: "));
+  EXPECT_THAT(msg, HasSubstr("k_soft"));
 }
 
 TEST_F(ScenarioFile, UnknownSection) {
@@ -72,12 +74,12 @@ TEST_F(ScenarioFile, UnknownSection) {
 }
 
 TEST_F(ScenarioFile, BadValuesNameWhatWasExpected) {
-  EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nstanley_k = fast\n")),
-              HasSubstr(":5: [control] stanley_k = 'fast' is not a number; expected a number in 1/s"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[control.stanley]\nk = fast\n")),
+              HasSubstr(":5: [control.stanley] k = 'fast' is not a number; expected a number in 1/s"));
   EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nlateral = mpc\n")),
               HasSubstr(":5: [control] lateral = 'mpc' is not known; expected one of: combined, stanley, pure_pursuit"));
-  EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nk_min = 1.5\n")),
-              HasSubstr(":5: [control] k_min = 1.5 is out of range; expected between 0 and 1"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[control.combined]\nk_min = 1.5\n")),
+              HasSubstr(":5: [control.combined] k_min = 1.5 is out of range; expected in [0, 1]"));
   EXPECT_THAT(error_of(write(std::string(kHead) + "[vehicle]\nmass = 190 lb\n")),
               HasSubstr(":5: [vehicle] mass = '190 lb': unit 'lb' does not fit; expected a number in kg"));
   EXPECT_THAT(error_of(write(std::string(kHead) + "[sim]\nphysics_rate = 1000.5\n")),
@@ -85,7 +87,7 @@ TEST_F(ScenarioFile, BadValuesNameWhatWasExpected) {
 }
 
 TEST_F(ScenarioFile, UnitsConvertToSI) {
-  const auto p = write(std::string(kHead) + "[vehicle]\nsteering_max = 30 deg\n[planning]\nv_max = 72 km/h\n");
+  const auto p = write(std::string(kHead) + "[vehicle]\nsteering_max = 30 deg\n[planning.reference.profile]\nv_max = 72 km/h\n");
   const Scenario s = load_scenario(p);
   EXPECT_NEAR(s.vehicle.steering_max, 30.0 * M_PI / 180.0, 1e-15);
   EXPECT_NEAR(s.planning.reference.profile.v_max, 20.0, 1e-12);
@@ -127,17 +129,17 @@ TEST(Scenario, DetectorKeysSetTheSimulatedDetectorNode) {
     load_scenario(kDefault, {"detector.range_full=40"});  // beyond range_max
     ADD_FAILURE() << "no error";
   } catch (const UserError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("[detector] range_max must be finite and > range_full"));
+    EXPECT_THAT(e.what(), HasSubstr("[detector] range_max must be > range_full"));
   }
 }
 
 TEST(Scenario, ResolvedFileReadsBackToTheSameScenario) {
-  const Scenario a = load_scenario(kDefault, {"control.stanley_k=3.25", "vehicle.steering_max=25 deg"});
+  Scenario a = load_scenario(kDefault, {"control.stanley.k=3.25", "vehicle.steering_max=25 deg"});
   const std::string text = resolved_ini(a);
-  // every key is written, defaults included
-  for (const auto& f : scenario_fields()) {
-    if (f.section != "expect") {
-      EXPECT_THAT(text, HasSubstr("\n" + f.key + " = ")) << f.section << "." << f.key;
+  // every key is written, defaults included, in its section
+  for (const Key& k : scenario_keys(a)) {
+    if (k.section != "expect") {
+      EXPECT_THAT(text, HasSubstr("\n" + k.name + " = " + k.get())) << k.path();
     }
   }
   const std::string p = (fs::temp_directory_path() / "paddock_resolved_test.ini").string();
@@ -149,6 +151,98 @@ TEST(Scenario, ResolvedFileReadsBackToTheSameScenario) {
   EXPECT_EQ(b.control.stanley.k, 3.25);
   EXPECT_EQ(b.vehicle.steering_max, a.vehicle.steering_max);  // bit-exact through the text
   fs::remove(p);
+}
+
+TEST_F(ScenarioFile, AnOldKeyNamesItsNewPlace) {
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nstanley_k = 2\n")),
+              HasSubstr(":5: unknown key 'stanley_k' in [control]; it is now [control.stanley] k"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[slam]\nmin_observations = 3\n")),
+              HasSubstr(":5: unknown section [slam]; it is now [cone_map] min_observations"));
+}
+
+TEST(Scenario, SectionsAndKeysFollowTheStructPaths) {
+  const Scenario s = load_scenario(kDefault, {"perception.lidar.clustering.tolerance=0.35", "control.pure_pursuit.L_min=3",
+                                              "planning.search.weight_colour=2.5", "perception.lidar.ground.max_slope=0.2"});
+  EXPECT_EQ(s.perception.lidar.clustering.tolerance, 0.35);
+  EXPECT_EQ(s.control.pure_pursuit.L_min, 3.0);
+  EXPECT_EQ(s.planning.search.weight_colour, 2.5);
+  EXPECT_EQ(s.perception.lidar.ground.max_slope, 0.2);
+  // and reach the stack
+  EXPECT_EQ(stack_params(s).perception.lidar.clustering.tolerance, 0.35);
+  EXPECT_EQ(stack_params(s).planner.search.weight_colour, 2.5);
+}
+
+// values other than k's own that its declaration allows (a rule tying it
+// to another field may still refuse some)
+std::vector<std::string> other_values(const Key& k) {
+  const std::string now = k.get();
+  std::vector<std::string> out;
+  if (k.expected == "text") return out;
+  if (k.expected == "true or false") return {now == "true" ? "false" : "true"};
+  if (k.expected.rfind("one of: ", 0) == 0) {
+    std::string rest = k.expected.substr(8);
+    for (std::size_t c; (c = rest.find(", ")) != std::string::npos; rest = rest.substr(c + 2)) {
+      if (rest.substr(0, c) != now) out.push_back(rest.substr(0, c));
+    }
+    if (rest != now) out.push_back(rest);
+    return out;
+  }
+  const double v = now.empty() ? 0.0 : std::stod(now);
+  for (double t : {v * 1.25, v * 0.8, v + 1.0, v - 1.0, v + 0.01, v - 0.01, 0.5, 1.0, 0.0}) {
+    if (k.integer) t = std::round(t);
+    if (t != v && k.bounds.contains(t)) out.push_back(k.integer ? std::to_string(static_cast<long>(t)) : params::number(t));
+  }
+  return out;
+}
+
+TEST(Scenario, OneParameterOfEveryParamsStructIsSetByItsStructPath) {
+  Scenario defaults = load_scenario(kDefault);
+  const std::vector<Key> keys = scenario_keys(defaults);
+  int sections_set = 0;
+  for (const SectionDoc& section : scenario_sections()) {
+    bool has_keys = false, set = false;
+    std::string tried;
+    for (const Key& k : keys) {
+      if (k.section != section.section || set) continue;
+      has_keys = true;
+      for (const std::string& value : other_values(k)) {
+        if (set) break;
+        const std::string override = k.path() + "=" + value;
+        tried += " " + override;
+        Scenario s;
+        try {
+          s = load_scenario(kDefault, {override});
+        } catch (const UserError&) {
+          continue;  // a rule tying it to another field: try another value or key
+        }
+        // the resolved scenario carries it in its section
+        const std::vector<IniEntry> entries = parse_ini_text(resolved_ini(s), "resolved", kRoot + "/scenarios");
+        for (const IniEntry& e : entries) {
+          if (e.section != k.section || e.key != k.name) continue;
+          if (k.expected.rfind("one of", 0) == 0 || k.expected == "true or false") EXPECT_EQ(e.value, value) << override;
+          else EXPECT_EQ(std::stod(e.value), std::stod(value)) << override;
+          set = true;
+        }
+        EXPECT_TRUE(set) << override << " is not in the resolved scenario";
+      }
+    }
+    if (!has_keys) continue;  // a struct of structs: its members are sections of their own
+    EXPECT_TRUE(set) << "no key of [" << section.section << "] could be set; tried:" << tried;
+    sections_set += set ? 1 : 0;
+  }
+  // every module's Params: the vehicle, the world, the sensors, perception's
+  // stages, planning's, control's, the mission's, the sim's
+  EXPECT_GE(sections_set, 35);
+}
+
+TEST(Scenario, TheReadmesTableOfKeysIsCurrent) {
+  const std::string readme = read_file(kRoot + "/README.md");
+  const std::string begin = "<!-- keys: generated by ./paddock keys -->\n", end = "<!-- keys end -->";
+  const auto a = readme.find(begin), b = readme.find(end);
+  ASSERT_NE(a, std::string::npos);
+  ASSERT_NE(b, std::string::npos);
+  EXPECT_EQ(readme.substr(a + begin.size(), b - a - begin.size()), "\n" + keys_markdown() + "\n")
+      << "run ./paddock keys and paste its table into the README between the markers";
 }
 
 }  // namespace

@@ -275,12 +275,12 @@ TEST(AnnotationDetector, HardwareEmptyAndMalformedFrames) {
 
 TEST(AnnotationDetector, ParamsValidation) {
   DetectorParams p;
-  EXPECT_EQ(validate(p), "");
+  EXPECT_EQ(params::validate(p), "");
   p.range_max = p.range_full;
-  EXPECT_NE(validate(p).find("range_max"), std::string::npos);
+  EXPECT_NE(params::validate(p).find("range_max"), std::string::npos);
   p = DetectorParams{};
   p.visible_full = 0.1;
-  EXPECT_NE(validate(p).find("visible_full"), std::string::npos);
+  EXPECT_NE(params::validate(p).find("visible_full"), std::string::npos);
   p = DetectorParams{};
   p.p_confuse_blue_yellow = 1.5;
   EXPECT_THROW(AnnotationDetector(p, 1), std::invalid_argument);

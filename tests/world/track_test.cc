@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -662,37 +661,6 @@ TEST(Build, LayoutsThatMakeNoSenseNameTheSource) {
   EXPECT_THAT([&] { build_track(c); }, ::testing::ThrowsMessage<TrackError>(HasSubstr("c.csv: cannot order")));
 }
 
-// ---------------------------------------------------------------------------
-// performance (optimised builds only)
-
-#ifdef NDEBUG
-TEST(Performance, BuildTheBiggestTrackUnder100ms) {
-  const TrackFile f = load_track_file(kTracks + "/fsg_2024.csv");
-  double best = 1e9;
-  for (int k = 0; k < 3; ++k) {
-    const auto t0 = std::chrono::steady_clock::now();
-    const TrackModel m = build_track(f);
-    best = std::min(best, std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    EXPECT_FALSE(m.centreline.empty());
-  }
-  EXPECT_LT(best, 100.0) << "ms";
-}
-
-TEST(Performance, OnTrackTakesAFewMicroseconds) {
-  const TrackModel& m = load("fsg_2024").model;
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> ux(-60, 60), uy(-100, 20);
-  std::vector<Vec2> q(100000);
-  for (auto& p : q) p = {ux(rng), uy(rng)};
-  std::size_t inside = 0;
-  const auto t0 = std::chrono::steady_clock::now();
-  for (const Vec2& p : q) inside += m.on_track(p);
-  const double us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count() /
-                    static_cast<double>(q.size());
-  EXPECT_GT(inside, 0u);
-  EXPECT_LT(us, 2.0) << "microseconds per call";
-}
-#endif
 
 }  // namespace
 }  // namespace paddock::world
