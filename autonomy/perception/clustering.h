@@ -75,7 +75,7 @@ struct ClusteringStats {
 
 class Clusterer {
  public:
-  // throws std::invalid_argument when validate(params) or validate(calibration) fails
+  // throws std::invalid_argument when params::validate fails for params or calibration
   Clusterer(const ClusteringParams& params, const LidarCalibration& calibration);
   ~Clusterer();
   Clusterer(Clusterer&&) noexcept;

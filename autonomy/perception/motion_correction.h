@@ -70,7 +70,7 @@ struct Cloud {
 
 class MotionCorrector {
  public:
-  // throws std::invalid_argument when validate(calibration) fails
+  // throws std::invalid_argument when params::validate(calibration) fails
   explicit MotionCorrector(const LidarCalibration& calibration);
 
   // fills `out` from the scan. With odometry covering every column's time

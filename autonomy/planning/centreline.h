@@ -34,7 +34,7 @@ namespace paddock::planning {
 // with colours most are safe: the search stops, inside the track, at a gap
 // of two or three missed cones in a row that it cannot bridge. The counts
 // quoted below are of those 840 laps (89 with the defaults).
-// Every field is an INI key `[planning] <name>`.
+// Every field is an INI key `[planning.search] <name>`.
 struct CentrelineParams {
   // the event horizon's largest depth and beam width (the search keeps a
   // branch's edges in fixed arrays of these sizes)

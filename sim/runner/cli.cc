@@ -101,16 +101,16 @@ int cmd_run(const std::vector<std::string>& args) {
   }
   if (scenario_path.empty()) throw UserError(std::string("run needs a scenario file\n") + kUsage);
 
-  const Scenario sc = load_scenario(scenario_path, overrides);
+  const Scenario scenario = load_scenario(scenario_path, overrides);
   std::vector<std::string> warnings;
-  const world::TrackModel track = load_track(sc.track_path, &warnings);
+  const world::TrackModel track = load_track(scenario.track_path, &warnings);
   for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
-  if (out_dir.empty()) out_dir = (std::filesystem::path("runs") / sc.name).string();
+  if (out_dir.empty()) out_dir = (std::filesystem::path("runs") / scenario.name).string();
 
-  const RunResult result = run(sc, track);
-  const auto failed = check_expectations(sc.expect, result);
-  const std::string js = summary_json(sc, result, failed);
-  write_file_atomic(out_dir + "/scenario.ini", resolved_ini(sc));
+  const RunResult result = run(scenario, track);
+  const auto failed = check_expectations(scenario.expect, result);
+  const std::string js = summary_json(scenario, result, failed);
+  write_file_atomic(out_dir + "/scenario.ini", resolved_ini(scenario));
   write_file_atomic(out_dir + "/log.csv", log_csv(result.log));
   write_file_atomic(out_dir + "/plan.json", plan_json(result));
   write_file_atomic(out_dir + "/summary.json", js);
@@ -135,7 +135,7 @@ int cmd_run(const std::vector<std::string>& args) {
   if (json) {
     std::cout << js;
   } else if (!quiet || !failed.empty()) {
-    std::cout << summary_text(sc, result, failed) << "  output      " << out_dir << "/\n";
+    std::cout << summary_text(scenario, result, failed) << "  output      " << out_dir << "/\n";
     for (const auto& f : figures) std::cout << "  figure      " << f << "\n";
   }
   return failed.empty() ? 0 : 3;

@@ -223,13 +223,13 @@ std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& so
 
 std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) {
   // the run's files: its resolved scenario names the track
-  const Scenario sc = load_scenario(dir + "/scenario.ini");
-  const world::TrackModel track = world::build_track(load_track_file(sc.track_path));
+  const Scenario scenario = load_scenario(dir + "/scenario.ini");
+  const world::TrackModel track = world::build_track(load_track_file(scenario.track_path));
   const std::vector<LogRow> log = parse_log_csv(read_file(dir + "/log.csv"), dir + "/log.csv");
   const SummaryLaps laps = read_summary(dir + "/summary.json");
   const std::string font_text = read_file(o.font_path);
   const std::vector<std::uint8_t> font(font_text.begin(), font_text.end());
-  const std::string event = events::to_string(sc.scenario.event);
+  const std::string event = events::to_string(scenario.scenario.event);
 
   render::FigureStyle map_style;
   map_style.width = map_style.height = o.map_size;
@@ -247,7 +247,7 @@ std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) 
   map.right = track.right;
   map.closed = track.closed;
   map.gates = track.gates;
-  map.start = start_pose(track, vehicle::footprint(sc.vehicle).x_max);
+  map.start = start_pose(track, vehicle::footprint(scenario.vehicle).x_max);
   for (const LogRow& r : log) {
     map.trajectory.push_back({r.x, r.y});
     map.speed.push_back(std::hypot(r.vx, r.vy));
@@ -270,7 +270,7 @@ std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) 
   ctl.lap_starts = laps.start;
 
   // the lap chart with the event's penalties
-  const events::Rules rules = events::rules_for(sc.scenario.event);
+  const events::Rules rules = events::rules_for(scenario.scenario.event);
   render::LapChartData chart;
   chart.title = laps.scenario + ": lap times";
   chart.lap_times = laps.time;

@@ -61,12 +61,12 @@ std::string report_controllers(const std::string& scenario_path, const std::vect
   o << "| controller | ITAE | RMS [m] | max lateral error [m] | lap time [s] | finished, DOO, OC | paper: ITAE / RMS / max / lap |\n";
   o << "|---|---|---|---|---|---|---|\n";
   for (const Row& row : rows) {
-    std::vector<std::string> ov = overrides;
-    ov.push_back(std::string("control.lateral=") + row.key);
-    const Scenario sc = load_scenario(scenario_path, ov);
-    name = sc.name;
-    const world::TrackModel track = world::build_track(load_track_file(sc.track_path));
-    const RunResult r = run(sc, track);
+    std::vector<std::string> with_controller = overrides;
+    with_controller.push_back(std::string("control.lateral=") + row.key);
+    const Scenario scenario = load_scenario(scenario_path, with_controller);
+    name = scenario.name;
+    const world::TrackModel track = world::build_track(load_track_file(scenario.track_path));
+    const RunResult r = run(scenario, track);
     // the mean lap, leaving out a standing-start first lap when there are more
     const auto& laps = r.event.laps;
     double lap = 0.0;
@@ -123,8 +123,9 @@ std::string report_smoothing(const std::string& track_path) {
       min_boundary = std::min({min_boundary, distance_to_loop(track.left, a.position()),
                                distance_to_loop(track.right, a.position())});
     }
-    const Stats sa = stats_of(ay), sc = stats_of(cvr);
-    ours.push_back({planning::lap_time(t), sa.max, sa.mean, sa.std, sc.max, sc.mean, sc.std, min_boundary});
+    const Stats lateral = stats_of(ay), curvature_rate = stats_of(cvr);
+    ours.push_back({planning::lap_time(t), lateral.max, lateral.mean, lateral.std, curvature_rate.max, curvature_rate.mean,
+                    curvature_rate.std, min_boundary});
   }
   const char* rows[] = {"Lap time [s]",         "Max lat. acc [m/s^2]", "Mean lat. acc [m/s^2]",
                         "Std lat. acc [m/s^2]", "Max CVR [1/m^2]",      "Mean CVR [1/m^2]",

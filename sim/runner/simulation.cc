@@ -99,9 +99,9 @@ void run_due(const SimModel& model, SimState& s) {
 
 std::unique_ptr<RawSensors> make_raw_sensors(const SimModel& model) {
   if (!model.raw_perception) return nullptr;
-  const Scenario& sc = model.scenario;
-  const std::uint64_t seed = sc.scenario.seed;
-  return std::make_unique<RawSensors>(sc.lidar, sc.ground, model.camera, sc.detector, stream_seed(seed, "lidar"),
+  const Scenario& scenario = model.scenario;
+  const std::uint64_t seed = scenario.scenario.seed;
+  return std::make_unique<RawSensors>(scenario.lidar, scenario.ground, model.camera, scenario.detector, stream_seed(seed, "lidar"),
                                       stream_seed(seed, "camera"), stream_seed(seed, "detector"));
 }
 

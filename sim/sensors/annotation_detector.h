@@ -111,7 +111,7 @@ struct AnnotationDetection {
 
 class AnnotationDetector {
  public:
-  // throws std::invalid_argument when validate(params) fails. The seed starts
+  // throws std::invalid_argument when params::validate(params) fails. The seed starts
   // the detector's own random stream (std::mt19937_64).
   AnnotationDetector(const DetectorParams& params, std::uint64_t seed);
 
