@@ -6,6 +6,7 @@
 //   void visit(V& v) {
 //     v(PADDOCK_PARAM(tolerance), {"m", params::above(0.0), "points closer than this join one cluster"});
 //     v(PADDOCK_PARAM(min_points), {"", params::at_least(1), "smaller clusters are dropped"});
+//     v(PADDOCK_PARAM(bounds), {"m", params::above(0.0), "region edges"});      // a std::vector: each item
 //     v(PADDOCK_PARAM(method), kMethodNames, "how the centreline is smoothed");  // an enum
 //     v(PADDOCK_PARAM(occlusion), "cones hide the cones behind them");              // a bool (or optional bool)
 //     v.section(PADDOCK_PARAM(ground), "the ground segmentation");                  // a nested Params
@@ -33,6 +34,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 // the key of a field is its member name
 #define PADDOCK_PARAM(member) #member, member
@@ -124,6 +126,13 @@ class Validator {
       const double v = static_cast<double>(field);
       if (!spec.bounds.contains(v))
         problem_ = prefix_ + key + " must be " + bounds_text(spec.bounds, spec.unit) + " (got " + number(v) + ")";
+    }
+  }
+  template <class T>
+  void operator()(const char* key, std::vector<T>& list, const Spec& spec) {
+    for (std::size_t i = 0; i < list.size() && problem_.empty(); ++i) {
+      const std::string item = std::string(key) + "[" + std::to_string(i) + "]";
+      (*this)(item.c_str(), list[i], spec);
     }
   }
   template <class E, std::size_t N>

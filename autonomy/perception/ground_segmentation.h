@@ -63,9 +63,7 @@ struct GroundSegmentationParams {
   // lowest to the highest; the ground's range noise moves near returns by
   // millimetres in height
   double vertical_threshold = 0.05;
-  // region boundaries (m, ascending ranges from the sensor, each > 0, at most
-  // 1000 of them; a list, so not visited: check() checks it): the ground's
-  // rings of a 0.15 m high sensor (-8 .. -0.5 deg, 0.5 deg apart) lie at 1.07
+  // the ground's rings of a 0.15 m high sensor (-8 .. -0.5 deg, 0.5 deg apart) lie at 1.07
   // .. 1.91 m (eight rings), 2.1, 2.5, 2.9, 3.4, 4.3, 5.7, 8.6 and 17.2 m;
   // beyond that only uphill ground returns
   std::vector<double> region_bounds{2.0, 4.0, 6.0, 9.0, 13.0, 20.0};
@@ -104,6 +102,7 @@ struct GroundSegmentationParams {
     v(PADDOCK_PARAM(max_slope), {"", params::above(0.0), "the steepest ground (dz / dr)"});
     v(PADDOCK_PARAM(gap_noise), {"m", params::at_least(0.0), "added to the expected gap between two returns of a column"});
     v(PADDOCK_PARAM(vertical_threshold), {"m", params::above(0.0), "a run of close returns rising by more than this is a vertical object"});
+    v(PADDOCK_PARAM(region_bounds), {"m", params::above(0.0), "the regions' ring edges: ranges from the sensor, ascending, at most 1000"});
     v(PADDOCK_PARAM(sectors), {"", params::in(1, 4096), "azimuth sectors of the regions"});
     v(PADDOCK_PARAM(ground_threshold), {"m", params::above(0.0), "a point less than this above its region's plane is ground"});
     v(PADDOCK_PARAM(fit_window), {"m", params::above(0.0),

@@ -32,8 +32,6 @@ struct SkidpadGeometry {
   double cone_offset = 0.15;
   // one every 22.5 degrees; the outer rings stop where they meet the lanes
   int cones_per_ring = 16;
-  // small orange lane cones' x (m), on both sides of the axis; lists, so not
-  // visited: check() checks that they are finite
   std::vector<double> entry_lane_x = {-15.0, -11.25};
   std::vector<double> exit_lane_x = {11.0, 16.0, 21.0};
   double exit_end_x = 21.0;
@@ -47,6 +45,8 @@ struct SkidpadGeometry {
     v(PADDOCK_PARAM(outer_diameter), {"m", params::above(0.0), "diameter of the outer boundary line"});
     v(PADDOCK_PARAM(cone_offset), {"m", params::at_least(0.0), "cones stand this far outside the lane's boundary lines"});
     v(PADDOCK_PARAM(cones_per_ring), {"", params::at_least(4), "cones per full ring, the first of each ring on the axis x = 0"});
+    v(PADDOCK_PARAM(entry_lane_x), {"m", params::any(), "the entry lane's small orange cones: their x, on both sides of the axis"});
+    v(PADDOCK_PARAM(exit_lane_x), {"m", params::any(), "the exit lane's small orange cones: their x, on both sides of the axis"});
     v(PADDOCK_PARAM(exit_end_x), {"m", params::above(0.0), "the exit lane is closed by a small orange cone on the axis here"});
     v(PADDOCK_PARAM(timekeeping_x), {"m", params::any(), "big orange timekeeping cones at (+-x, +-y): x"});
     v(PADDOCK_PARAM(timekeeping_y), {"m", params::any(), "big orange timekeeping cones at (+-x, +-y): y"});

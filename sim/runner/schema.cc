@@ -79,6 +79,34 @@ class KeyCollector {
     keys.push_back(std::move(k));
   }
 
+  // a list: numbers separated by commas, each in the bounds
+  template <class T>
+  void operator()(const char* name, std::vector<T>& field, const params::Spec& spec) {
+    Key k = key(name, spec.unit, "numbers separated by commas, each " + params::bounds_text(spec.bounds, spec.unit), spec.doc);
+    k.bounds = spec.bounds;
+    k.list = true;
+    std::vector<T>* f = &field;
+    k.set = [f, spec](const IniEntry& e) {
+      std::vector<T> items;
+      std::string rest = e.value;
+      for (;;) {
+        const auto comma = rest.find(',');
+        IniEntry item = e;
+        item.value = trim(rest.substr(0, comma));
+        items.push_back(parse_number<T>(item, spec));
+        if (comma == std::string::npos) break;
+        rest = rest.substr(comma + 1);
+      }
+      *f = std::move(items);
+    };
+    k.get = [f] {
+      std::string text;
+      for (const T& v : *f) text += (text.empty() ? "" : ", ") + text_of(v);
+      return text;
+    };
+    keys.push_back(std::move(k));
+  }
+
   template <class E, std::size_t N>
   void operator()(const char* name, E& field, const params::Choice<E> (&choices)[N], const char* doc) {
     std::string names;

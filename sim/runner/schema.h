@@ -27,6 +27,7 @@ struct Key {
   bool required = false;  // no default in code (a NaN: the [vehicle] keys)
   params::Bounds bounds;  // a number's bounds (any for other kinds)
   bool integer = false;   // a whole number
+  bool list = false;      // numbers separated by commas
   // parses e.value into the field; throws UserError "file:line: ..."
   std::function<void(const IniEntry& e)> set;
   // the field's value as INI text ("" when an optional value is unset)

@@ -33,6 +33,7 @@ struct Outer {
   bool flag = true;
   Mode mode = Mode::A;
   std::optional<double> limit;
+  std::vector<double> edges{1.0, 2.0};
   Inner inner;
   static constexpr Choice<Mode> kModes[] = {{"a", Mode::A}, {"b", Mode::B}};
   template <class V>
@@ -41,6 +42,7 @@ struct Outer {
     v(PADDOCK_PARAM(flag), "a flag");
     v(PADDOCK_PARAM(mode), kModes, "a mode");
     v(PADDOCK_PARAM(limit), {"m", at_least(0.0), "an optional limit"});
+    v(PADDOCK_PARAM(edges), {"m", above(0.0), "a list"});
     v.section(PADDOCK_PARAM(inner), "the inner part");
   }
 };
@@ -117,6 +119,14 @@ TEST(Params, IntegersAndOptionalsAreChecked) {
   EXPECT_EQ(validate(p), "");
 }
 
+TEST(Params, EveryItemOfAListIsChecked) {
+  Outer o;
+  o.edges = {1.0, 0.0, -1.0};
+  EXPECT_EQ(validate(o), "edges[1] must be > 0 m (got 0)");
+  o.edges.clear();
+  EXPECT_EQ(validate(o), "");
+}
+
 TEST(Params, CrossFieldChecksRunWithTheirPath) {
   Outer o;
   o.inner.gain = 3.0;
@@ -147,7 +157,7 @@ TEST(Params, AVisitorSeesEveryFieldOnceInDeclarationOrder) {
   Outer o;
   PathLister l;
   o.visit(l);
-  EXPECT_EQ(l.paths, (std::vector<std::string>{"share", "flag", "mode", "limit", "inner.gain", "inner.count"}));
+  EXPECT_EQ(l.paths, (std::vector<std::string>{"share", "flag", "mode", "limit", "edges", "inner.gain", "inner.count"}));
 }
 
 }  // namespace

@@ -560,7 +560,9 @@ TEST(LidarPipelineTest, ValidateNamesTheField) {
   EXPECT_EQ(params::validate(p), "ground.max_slope must be > 0 (got -1)");
   p = LidarPipelineParams{};
   p.ground.region_bounds = {3.0, 2.0};
-  EXPECT_EQ(params::validate(p), "ground.region_bounds must be finite, > 0 m and ascending (got 2 at 1)");
+  EXPECT_EQ(params::validate(p), "ground.region_bounds must be ascending (item 1)");
+  p.ground.region_bounds = {2.0, -3.0};
+  EXPECT_EQ(params::validate(p), "ground.region_bounds[1] must be > 0 m (got -3)");
   p = LidarPipelineParams{};
   p.clustering.tolerance = 0.0;
   EXPECT_EQ(params::validate(p), "clustering.tolerance must be > 0 m (got 0)");
