@@ -34,16 +34,16 @@ Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<percep
       controller_(params.control, params.vehicle),
       cone_map_(params.cone_map),
       gates_(spec_.gates) {
-  if (params_.modes.perception != PerceptionMode::GroundTruth) {
+  if (params_.autonomy.perception != PerceptionMode::GroundTruth) {
     perception::PerceptionParams pp = params_.perception;
-    pp.use_camera = params_.modes.perception == PerceptionMode::LidarCamera;
+    pp.use_camera = params_.autonomy.perception == PerceptionMode::LidarCamera;
     perception_ = std::make_unique<perception::Perception>(pp, std::move(detector));
   }
-  if (params_.modes.planner != PlannerMode::Oracle) return;
+  if (params_.autonomy.planner != PlannerMode::Oracle) return;
   // planner = oracle: the whole reference is planned once, before the start;
   // an open path starts free (the car launches at full drive) and ends at rest
   const std::optional<double> v_end = spec_.oracle_closed ? std::nullopt : std::optional<double>(0.0);
-  auto result = planning::build_reference(spec_.oracle_path, spec_.oracle_closed, params_.planner.reference,
+  auto result = planning::build_reference(spec_.oracle_path, spec_.oracle_closed, params_.planning.reference,
                                           std::nullopt, v_end);
   if (result.ok()) {
     trajectory_ = std::move(result.trajectory);
@@ -179,9 +179,9 @@ void Stack::plan(const hal::StateEstimate& st) {
   // autocross and trackdrive: the centreline of the map explored so far
   planning::PlanResult res =
       spec_.mission == Mission::Acceleration
-          ? planning::plan_acceleration(cones, st.pose, speed, params_.planner,
+          ? planning::plan_acceleration(cones, st.pose, speed, params_.planning,
                                         std::max(10.0, mp.acceleration_length - driven_))
-          : planning::plan_path(cones, st.pose, speed, params_.planner,
+          : planning::plan_path(cones, st.pose, speed, params_.planning,
                                 driven_ >= mp.loop_closure_distance);
   ++telemetry_.plans;
   if (!res.ok()) {
@@ -296,7 +296,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   last_tick_ = now;
 
   // planner = delaunay: plan whenever the map has news (also before the go, so the car is ready)
-  if (params_.modes.planner == PlannerMode::Delaunay && state_ && map_news_) plan(*state_);
+  if (params_.autonomy.planner == PlannerMode::Delaunay && state_ && map_news_) plan(*state_);
 
   // the AS state machine: off -> ready (plan and state known) -> driving (go)
   // -> finished (stopped after the mission); emergency from any state

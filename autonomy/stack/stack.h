@@ -102,11 +102,11 @@ struct MissionParams {
 };
 
 struct StackParams {
-  AutonomyModes modes;
+  AutonomyModes autonomy;
   // perception = lidar | lidar_camera (use_camera follows the mode)
   perception::PerceptionParams perception;
   // its reference params serve the oracle mode too
-  planning::PathPlannerParams planner;
+  planning::PathPlannerParams planning;
   planning::SkidpadParams skidpad;
   control::ControlParams control;
   // not visited: the runner fills it from the vehicle ([vehicle]); check()
@@ -118,9 +118,9 @@ struct StackParams {
 
   template <class V>
   void visit(V& v) {
-    v.section(PADDOCK_PARAM(modes), "where each layer's input comes from");
+    v.section(PADDOCK_PARAM(autonomy), "where each layer's input comes from");
     v.section(PADDOCK_PARAM(perception), "the perception front (perception = lidar | lidar_camera)");
-    v.section(PADDOCK_PARAM(planner), "one planning cycle (planner = delaunay); its reference serves the oracle mode too");
+    v.section(PADDOCK_PARAM(planning), "one planning cycle (planner = delaunay); its reference serves the oracle mode too");
     v.section(PADDOCK_PARAM(skidpad), "the skidpad's precalculated path and its alignment");
     v.section(PADDOCK_PARAM(control), "the lateral law and the speed loop");
     v.section(PADDOCK_PARAM(mission), "the mission logic of each event");

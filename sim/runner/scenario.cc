@@ -184,7 +184,7 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   const stack::StackParams stack = stack_params(s);
   Scenario as_used = s;
   as_used.perception = stack.perception;
-  as_used.planning = stack.planner;
+  as_used.planning = stack.planning;
   as_used.skidpad = stack.skidpad;
   if (const std::string why = params::validate(as_used); !why.empty()) throw UserError(path + ": " + as_section_key(why));
   if (const std::string why = params::validate(stack); !why.empty()) {
@@ -239,7 +239,7 @@ std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream) 
 
 stack::StackParams stack_params(const Scenario& s) {
   stack::StackParams p;
-  p.modes = s.autonomy;
+  p.autonomy = s.autonomy;
   p.control = s.control;
   p.mission = s.mission;
   p.cone_map = s.cone_map;
@@ -264,12 +264,12 @@ stack::StackParams stack_params(const Scenario& s) {
   p.perception.odometry.wheel_radius = v.wheel_radius;
   p.perception.lidar.calibration = static_cast<const hal::LidarLayout&>(s.lidar);
   p.perception.camera = sensors::camera_calibration(s.camera);
-  p.planner = s.planning;
-  p.planner.reference.profile.mass = v.mass;
-  p.planner.reference.profile.drag_coefficient = v.c_drag;
+  p.planning = s.planning;
+  p.planning.reference.profile.mass = v.mass;
+  p.planning.reference.profile.drag_coefficient = v.c_drag;
   // the skidpad's reference uses the same planned limits
   p.skidpad = s.skidpad;
-  p.skidpad.reference = p.planner.reference;
+  p.skidpad.reference = p.planning.reference;
   return p;
 }
 

@@ -39,7 +39,7 @@ TEST(ClosedLoop, FlyingLapsMatchTheReferenceTrajectorysOwnLapTime) {
   const LoopRun& r = default_run();
   ASSERT_TRUE(r.result.event.finished) << r.result.event.dnf_reason;
   // the reference as the stack plans it, timed at its own speeds
-  const auto ref = planning::build_reference(r.track.centreline, true, stack_params(r.scenario).planner.reference);
+  const auto ref = planning::build_reference(r.track.centreline, true, stack_params(r.scenario).planning.reference);
   ASSERT_TRUE(ref.ok()) << ref.reason;
   const double planned = planning::lap_time(ref.trajectory);
   // laps 2..10 start at speed, as the profile assumes; a car that tracks the

@@ -169,7 +169,7 @@ TEST(Scenario, SectionsAndKeysFollowTheStructPaths) {
   EXPECT_EQ(s.perception.lidar.ground.max_slope, 0.2);
   // and reach the stack
   EXPECT_EQ(stack_params(s).perception.lidar.clustering.tolerance, 0.35);
-  EXPECT_EQ(stack_params(s).planner.search.weight_colour, 2.5);
+  EXPECT_EQ(stack_params(s).planning.search.weight_colour, 2.5);
 }
 
 // values other than k's own that its declaration allows (a rule tying it

@@ -47,7 +47,7 @@ MissionSpec circle_mission(int crossings) {
 // these tests drive the oracle planner: the path is given
 StackParams oracle_params() {
   StackParams p;
-  p.modes.planner = PlannerMode::Oracle;
+  p.autonomy.planner = PlannerMode::Oracle;
   return p;
 }
 
@@ -203,7 +203,7 @@ void drive_corridor(Stack& s, const std::vector<Cone>& track, double x0, double 
 // (counted, it would be the autocross's finish and stop the car)
 TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
   StackParams p;
-  p.modes.planner = PlannerMode::Delaunay;
+  p.autonomy.planner = PlannerMode::Delaunay;
   MissionSpec m;
   m.mission = Mission::Autocross;
   m.finish_crossings = 2;
@@ -239,7 +239,7 @@ TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
 // from the path it drove, then the finish, and stops (the mission needs 2)
 TEST(Stack, AGateSeenOnlyAfterTheCarCrossedItCounts) {
   StackParams p;
-  p.modes.planner = PlannerMode::Delaunay;
+  p.autonomy.planner = PlannerMode::Delaunay;
   MissionSpec m;
   m.mission = Mission::Acceleration;
   m.finish_crossings = 2;
@@ -294,11 +294,11 @@ TEST(StackParams, EveryParameterHasOnePathAndWhatTheRunnerFillsHasNone) {
   std::sort(sorted.begin(), sorted.end());
   EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
   const auto has = [&](const std::string& path) { return std::count(l.paths.begin(), l.paths.end(), path) == 1; };
-  for (const char* path : {"modes.perception", "modes.slam", "modes.planner", "perception.odometry.history",
+  for (const char* path : {"autonomy.perception", "autonomy.slam", "autonomy.planner", "perception.odometry.history",
                            "perception.lidar.ground.max_slope", "perception.lidar.clustering.tolerance",
                            "perception.fusion.camera_range", "perception.camera_sync_tolerance",
-                           "planner.search.search_radius", "planner.smoothing.method", "planner.clearance.clearance",
-                           "planner.reference.profile.v_max", "skidpad.path.geometry.centre_distance",
+                           "planning.search.search_radius", "planning.smoothing.method", "planning.clearance.clearance",
+                           "planning.reference.profile.v_max", "skidpad.path.geometry.centre_distance",
                            "skidpad.gicp.k_neighbours", "skidpad.max_rmse", "control.lateral",
                            "control.stanley.use_steady_state_yaw", "control.longitudinal.kp", "mission.stop_decel",
                            "cone_map.min_observations", "gates.post_radius"})
@@ -306,7 +306,7 @@ TEST(StackParams, EveryParameterHasOnePathAndWhatTheRunnerFillsHasNone) {
   // derived by the runner, or a run-time switch: not parameters of their own
   for (const char* path : {"seed", "vehicle.mass", "perception.use_camera", "perception.odometry.wheel_radius",
                            "perception.lidar.calibration.channels", "perception.lidar.keep_points",
-                           "planner.reference.profile.mass", "planner.reference.profile.drag_coefficient",
+                           "planning.reference.profile.mass", "planning.reference.profile.drag_coefficient",
                            "skidpad.reference.ds"})
     EXPECT_FALSE(has(path)) << path;
 }
@@ -318,8 +318,8 @@ TEST(StackParams, ValidateChecksTheWholeStackWithPaths) {
   p.perception.use_camera = false;
   EXPECT_EQ(params::validate(p), "");
   StackParams q = p;
-  q.planner.search.horizon_depth = 9;
-  EXPECT_EQ(params::validate(q), "planner.search.horizon_depth must be in [1, 8] (got 9)");
+  q.planning.search.horizon_depth = 9;
+  EXPECT_EQ(params::validate(q), "planning.search.horizon_depth must be in [1, 8] (got 9)");
   q = p;
   q.gates.max_width = 1.0;
   EXPECT_EQ(params::validate(q), "gates.max_width must be >= min_width");
@@ -331,8 +331,8 @@ TEST(StackParams, ValidateChecksTheWholeStackWithPaths) {
   q.skidpad.reference.ds = 0.0;
   EXPECT_EQ(params::validate(q), "skidpad.reference.ds must be in [0.01, 10] m (got 0)");
   q = p;
-  q.planner.reference.profile.mass = -1.0;
-  EXPECT_EQ(params::validate(q), "planner.reference.profile.mass must be > 0 kg (got -1)");
+  q.planning.reference.profile.mass = -1.0;
+  EXPECT_EQ(params::validate(q), "planning.reference.profile.mass must be > 0 kg (got -1)");
   q = p;
   q.perception.odometry.wheel_radius = 0.0;
   EXPECT_EQ(params::validate(q), "perception.odometry.wheel_radius must be > 0 m (got 0)");
