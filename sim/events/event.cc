@@ -52,7 +52,7 @@ Rules rules_for(EventKind kind) {
 }
 
 Event::Event(EventKind kind, const world::TrackModel& track, const EventParams& params)
-    : kind_(kind), rules_(rules_for(kind)), params_(params), track_(&track) {
+    : kind_(kind), rules_(rules_for(kind)), params_(params::require_valid(params, "EventParams")), track_(&track) {
   // acceleration times from the start gate to the finish gate; every other
   // event times laps across one gate
   if (kind == EventKind::Acceleration && track.gates.size() >= 2) {

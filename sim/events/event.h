@@ -79,6 +79,7 @@ struct CarSample {
 
 class Event {
  public:
+  // throws std::invalid_argument when params::validate(params) fails
   Event(EventKind kind, const world::TrackModel& track, const EventParams& params);
 
   // timing: called every physics step with the nose's motion since the last call

@@ -38,6 +38,8 @@ TEST(EventParams, DefaultsAreValidAndABadValueIsNamed) {
   EventParams p;
   p.stall_time = 0.0;
   EXPECT_EQ(params::validate(p), "stall_time must be in [0.1, 600] s (got 0)");
+  // and an event will not run with it
+  EXPECT_THROW(Event(EventKind::Autocross, strip_track(), p), std::invalid_argument);
 }
 
 TEST(Event, LapTimesAreInterpolatedGateToGate) {
