@@ -149,6 +149,10 @@ void Event::on_sample(const CarSample& s) {
   }
 }
 
+void Event::abort(double t, const std::string& reason) {
+  if (!done_) finish_run(false, reason, t);
+}
+
 void Event::finish_run(bool finished, const std::string& reason, double t) {
   done_ = true;
   result_.finished = finished;

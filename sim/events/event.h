@@ -88,6 +88,8 @@ class Event {
   void on_sample(const CarSample& s);
   // the go signal was given at this time
   void start(double t) { go_time_ = t; }
+  // the run cannot go on (the simulation diverged): a DNF at t with this reason
+  void abort(double t, const std::string& reason);
 
   bool done() const { return done_; }
   const Result& result() const { return result_; }

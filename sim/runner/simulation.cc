@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 namespace paddock::runner {
 namespace {
@@ -161,6 +162,19 @@ void step(const SimModel& model, SimState& s) {
   const double nose_x = model.footprint.x_max;
   const Vec2 nose0 = vehicle::base_pose(car, s.car).transform({nose_x, 0.0});
   vehicle::step(car, s.car, s.input, model.dt);
+  if (!vehicle::is_finite(s.car)) {
+    // a state that is no number cannot be stepped, sensed or timed: the run
+    // ends here, with its reason; nothing falls due at this instant
+    ++s.k;
+    s.now = s.k * model.dt_ns;
+    s.t = static_cast<double>(s.k) * model.dt;
+    char why[96];
+    std::snprintf(why, sizeof why, "simulation diverged at t = %.3f s (the vehicle state is not finite)", s.t);
+    s.event.abort(s.t, why);
+    s.done = true;
+    s.controlled = s.sampled = false;
+    return;
+  }
   const Pose2 base = vehicle::base_pose(car, s.car);
   const Vec2 v_world = rotate(vehicle::base_velocity(car, s.car), base.yaw);
   s.cones.step(base, v_world.x, v_world.y, s.car.r, model.dt);

@@ -244,6 +244,12 @@ inline double finite_or(double v, double fallback) { return std::isfinite(v) ? v
 
 double standstill_speed(const VehicleParams& p, double dt) { return standstill_speed_impl(p, dt); }
 
+bool is_finite(const VehicleState& s) {
+  for (const double v : {s.x, s.y, s.yaw, s.vx, s.vy, s.r, s.steering, s.throttle, s.brake, s.ax_load, s.ax, s.ay, s.yaw_accel})
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
 VehicleState initial_state(const VehicleParams& p, Pose2 base_pose_in) {
   VehicleState s;
   // the CG lies lr ahead of the rear axle centre

@@ -137,6 +137,10 @@ struct VehicleState {
   std::size_t delay_head = 0;  // index of the slot the next command is written to
 };
 
+// every quantity of the state is a finite number (a state that is not has
+// diverged: too large a step for the parameters)
+bool is_finite(const VehicleState& s);
+
 // the state at rest with the base frame (rear axle centre on the ground) at base_pose
 VehicleState initial_state(const VehicleParams& p, Pose2 base_pose);
 

@@ -139,6 +139,24 @@ TEST(Simulation, TwoModelsWithOtherSeedsOnTwoThreadsStayApart) {
   EXPECT_TRUE(same_rows(alone2.log, b.log));
 }
 
+TEST(Simulation, ADivergingCarEndsTheRunWithItsReasonNotACrash) {
+  // a car of 1 g passes the bounds (mass > 0) but no 1 ms step can follow
+  // it: the run stops at the first state that is not a number, says so,
+  // and writes no row that is not one (with the raw LiDAR and camera on)
+  const ScenarioOnTrack& s = default_setup();
+  Scenario light = s.scenario;
+  light.vehicle.mass = 0.001;
+  const RunResult r = run(light, s.track);
+  EXPECT_FALSE(r.event.finished);
+  EXPECT_EQ(r.event.dnf_reason.rfind("simulation diverged at t = ", 0), 0u) << r.event.dnf_reason;
+  ASSERT_FALSE(r.log.empty());
+  for (const LogRow& row : r.log) {
+    ASSERT_TRUE(std::isfinite(row.x) && std::isfinite(row.y) && std::isfinite(row.vx) && std::isfinite(row.yaw_rate))
+        << "t = " << row.t;
+  }
+  EXPECT_LT(r.sim_time, 11.0);  // it stopped before the event's timeout
+}
+
 TEST(Simulation, StreamSeedsDifferPerStream) {
   const char* streams[] = {"cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera", "detector"};
   for (const char* a : streams) {
