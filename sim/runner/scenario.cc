@@ -1,6 +1,7 @@
 #include "sim/runner/scenario.h"
 
 #include <cassert>
+#include <cmath>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -170,6 +171,14 @@ std::string as_section_key(const std::string& problem) {
 }
 
 }  // namespace
+
+std::string Scenario::check() const {
+  const double limit = vehicle::stable_step_limit(vehicle);
+  if (1.0 / sim.physics_rate <= limit) return "";
+  return "sim.physics_rate must be at least " + std::to_string(static_cast<int>(std::ceil(1.0 / limit))) +
+         " Hz for this vehicle (its tyre modes need a step of at most " + params::number(std::floor(limit * 1e4) / 10.0) +
+         " ms to integrate stably)";
+}
 
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides) {
   std::vector<IniEntry> entries = read_ini_file(path);

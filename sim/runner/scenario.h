@@ -158,6 +158,9 @@ struct Scenario {
     v.section(PADDOCK_PARAM(sim), "the simulation's rates");
     v.section(PADDOCK_PARAM(expect), "what a CI scenario must achieve (unset entries are not checked)");
   }
+  // what ties sections together: the physics step must be one the vehicle
+  // model integrates stably (vehicle::stable_step_limit)
+  std::string check() const;
 };
 
 // reads, resolves includes, applies the overrides ("section.key=value"), checks

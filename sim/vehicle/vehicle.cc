@@ -244,6 +244,18 @@ inline double finite_or(double v, double fallback) { return std::isfinite(v) ? v
 
 double standstill_speed(const VehicleParams& p, double dt) { return standstill_speed_impl(p, dt); }
 
+double stable_step_limit(const VehicleParams& p) {
+  const double v = 1.5;  // m/s, where dynamic_weight starts to rise
+  const double wheelbase = p.lf + p.lr;
+  const double fz_front = p.mass * kGravity * p.lr / wheelbase;
+  const double fz_rear = p.mass * kGravity * p.lf / wheelbase;
+  const double bcd = p.tyre_b * p.tyre_c * p.tyre_d;
+  const double c_front = bcd * fz_front, c_rear = bcd * fz_rear;
+  const double lateral = (c_front + c_rear) / (p.mass * v);
+  const double yaw = (c_front * p.lf * p.lf + c_rear * p.lr * p.lr) / (p.inertia_z * v);
+  return 2.5 / std::max(lateral, yaw);
+}
+
 bool is_finite(const VehicleState& s) {
   for (const double v : {s.x, s.y, s.yaw, s.vx, s.vy, s.r, s.steering, s.throttle, s.brake, s.ax_load, s.ax, s.ay, s.yaw_accel})
     if (!std::isfinite(v)) return false;

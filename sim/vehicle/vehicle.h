@@ -67,39 +67,43 @@ struct VehicleParams {
 
   template <class V>
   void visit(V& v) {
-    v(PADDOCK_PARAM(mass), {"kg", params::above(0.0), "total mass of the car"});
-    v(PADDOCK_PARAM(inertia_z), {"kg m^2", params::above(0.0), "yaw moment of inertia about the CG"});
-    v(PADDOCK_PARAM(lf), {"m", params::above(0.0), "CG to front axle (along x)"});
-    v(PADDOCK_PARAM(lr), {"m", params::above(0.0), "CG to rear axle (along x)"});
-    v(PADDOCK_PARAM(h_cg), {"m", params::at_least(0.0), "CG height above ground (longitudinal load transfer)"});
-    v(PADDOCK_PARAM(track_front), {"m", params::above(0.0), "distance between the front contact patches"});
-    v(PADDOCK_PARAM(track_rear), {"m", params::above(0.0), "distance between the rear contact patches"});
-    v(PADDOCK_PARAM(wheel_radius), {"m", params::above(0.0), "dynamic rolling radius"});
-    v(PADDOCK_PARAM(tyre_b), {"1/rad", params::above(0.0), "Pacejka stiffness factor B"});
+    // the ranges keep the model physical for the cars paddock is for (FS cars
+    // weigh 150-300 kg and corner at 1.5-2.5 g): wide enough for karts and
+    // small road cars, narrow enough that no value drives the state to NaN
+    v(PADDOCK_PARAM(mass), {"kg", params::in(50.0, 2000.0), "total mass of the car"});
+    v(PADDOCK_PARAM(inertia_z), {"kg m^2", params::in(5.0, 5000.0), "yaw moment of inertia about the CG"});
+    v(PADDOCK_PARAM(lf), {"m", params::in(0.2, 3.0), "CG to front axle (along x)"});
+    v(PADDOCK_PARAM(lr), {"m", params::in(0.2, 3.0), "CG to rear axle (along x)"});
+    v(PADDOCK_PARAM(h_cg), {"m", params::in(0.0, 1.5), "CG height above ground (longitudinal load transfer)"});
+    v(PADDOCK_PARAM(track_front), {"m", params::in(0.5, 3.0), "distance between the front contact patches"});
+    v(PADDOCK_PARAM(track_rear), {"m", params::in(0.5, 3.0), "distance between the rear contact patches"});
+    v(PADDOCK_PARAM(wheel_radius), {"m", params::in(0.1, 0.6), "dynamic rolling radius"});
+    v(PADDOCK_PARAM(tyre_b), {"1/rad", params::above_up_to(0.0, 50.0), "Pacejka stiffness factor B"});
     // C >= 2 would make the force change sign at large slip
     v(PADDOCK_PARAM(tyre_c), {"", params::Bounds{0.0, 2.0, true, true}, "Pacejka shape factor C"});
-    v(PADDOCK_PARAM(tyre_d), {"", params::above(0.0), "Pacejka peak friction coefficient D (also the friction ellipse radius)"});
+    // slicks on dry asphalt reach 1.5-1.8; no tyre reaches 3
+    v(PADDOCK_PARAM(tyre_d), {"", params::above_up_to(0.0, 3.0), "Pacejka peak friction coefficient D (also the friction ellipse radius)"});
     // E <= 1 keeps B a - E (B a - atan(B a)) increasing in a
     v(PADDOCK_PARAM(tyre_e), {"", params::at_most(1.0), "Pacejka curvature factor E"});
-    v(PADDOCK_PARAM(c_down), {"N s^2/m^2", params::at_least(0.0), "downforce F = c_down vx^2"});
+    v(PADDOCK_PARAM(c_down), {"N s^2/m^2", params::in(0.0, 20.0), "downforce F = c_down vx^2"});
     v(PADDOCK_PARAM(aero_balance_front), {"", params::fraction(), "share of the downforce on the front axle"});
-    v(PADDOCK_PARAM(c_drag), {"N s^2/m^2", params::at_least(0.0), "drag F = c_drag vx^2"});
-    v(PADDOCK_PARAM(cm1), {"N", params::at_least(0.0), "motor force at full throttle (all driven wheels)"});
-    v(PADDOCK_PARAM(cr0), {"N", params::at_least(0.0), "rolling resistance"});
+    v(PADDOCK_PARAM(c_drag), {"N s^2/m^2", params::in(0.0, 20.0), "drag F = c_drag vx^2"});
+    v(PADDOCK_PARAM(cm1), {"N", params::in(0.0, 20000.0), "motor force at full throttle (all driven wheels)"});
+    v(PADDOCK_PARAM(cr0), {"N", params::in(0.0, 2000.0), "rolling resistance"});
     v(PADDOCK_PARAM(drive_split_front), {"", params::fraction(), "share of the motor force on the front axle"});
-    v(PADDOCK_PARAM(brake_force_max), {"N", params::at_least(0.0), "total brake force at full brake"});
+    v(PADDOCK_PARAM(brake_force_max), {"N", params::in(0.0, 20000.0), "total brake force at full brake"});
     v(PADDOCK_PARAM(brake_split_front), {"", params::fraction(), "share of the brake force on the front axle (brake balance)"});
-    v(PADDOCK_PARAM(pitch_time_constant), {"s", params::above(0.0), "lag of the longitudinal load transfer behind the acceleration (pitch dynamics)"});
+    v(PADDOCK_PARAM(pitch_time_constant), {"s", params::above_up_to(0.0, 5.0), "lag of the longitudinal load transfer behind the acceleration (pitch dynamics)"});
     // below pi/2 so that tan(steering) of the kinematic model stays finite
     v(PADDOCK_PARAM(steering_max), {"rad", params::above_up_to(0.0, 1.5), "road-wheel angle limit (symmetric)"});
-    v(PADDOCK_PARAM(steering_rate_max), {"rad/s", params::above(0.0), "road-wheel angle rate limit"});
-    v(PADDOCK_PARAM(steering_time_constant), {"s", params::at_least(0.0), "first-order lag of the steering actuator (< dt/2: instantaneous)"});
+    v(PADDOCK_PARAM(steering_rate_max), {"rad/s", params::above_up_to(0.0, 20.0), "road-wheel angle rate limit"});
+    v(PADDOCK_PARAM(steering_time_constant), {"s", params::in(0.0, 5.0), "first-order lag of the steering actuator (< dt/2: instantaneous)"});
     v(PADDOCK_PARAM(steering_dead_time), {"s", params::in(0.0, kMaxSteeringDeadTime), "pure delay on the steering command (rounded to whole steps)"});
-    v(PADDOCK_PARAM(throttle_time_constant), {"s", params::at_least(0.0), "first-order lag of the motor force (< dt/2: instantaneous)"});
-    v(PADDOCK_PARAM(brake_time_constant), {"s", params::at_least(0.0), "first-order lag of the brake force (< dt/2: instantaneous)"});
-    v(PADDOCK_PARAM(front_overhang), {"m", params::at_least(0.0), "front axle to the front of the car (nose, front wing)"});
-    v(PADDOCK_PARAM(rear_overhang), {"m", params::at_least(0.0), "rear axle to the back of the car"});
-    v(PADDOCK_PARAM(body_width), {"m", params::above(0.0), "overall width (tyres included)"});
+    v(PADDOCK_PARAM(throttle_time_constant), {"s", params::in(0.0, 5.0), "first-order lag of the motor force (< dt/2: instantaneous)"});
+    v(PADDOCK_PARAM(brake_time_constant), {"s", params::in(0.0, 5.0), "first-order lag of the brake force (< dt/2: instantaneous)"});
+    v(PADDOCK_PARAM(front_overhang), {"m", params::in(0.0, 3.0), "front axle to the front of the car (nose, front wing)"});
+    v(PADDOCK_PARAM(rear_overhang), {"m", params::in(0.0, 3.0), "rear axle to the back of the car"});
+    v(PADDOCK_PARAM(body_width), {"m", params::above_up_to(0.0, 3.0), "overall width (tyres included)"});
   }
 };
 
@@ -153,6 +157,18 @@ double tyre_lateral_force(const VehicleParams& p, double alpha, double fz);
 
 // weight of the dynamic model in the low-speed blend: clamp(0.5 (|v| - 1.5), 0, 1)
 double dynamic_weight(double speed);
+
+// the longest physics step (s) the explicit RK4 integration stays stable at
+// for this car: 2.5 / lambda, lambda the faster of the linear single-track
+// model's lateral and yaw modes at the speed where the dynamic model starts
+// to count (1.5 m/s, dynamic_weight), where they are fastest (both grow as
+// 1 / v; downforce only adds a v^2 load that the 1 / v outweighs below
+// ~10 m/s). With C_f = B C D Fz_f, C_r likewise at the static axle loads:
+//   lateral  lambda_y = (C_f + C_r) / (m v)
+//   yaw      lambda_r = (C_f lf^2 + C_r lr^2) / (Iz v)
+// RK4's stability interval on the real axis is 2.785 / lambda; 2.5 keeps a
+// margin. The default car: lambda ~ 183 1/s, 13.6 ms (74 Hz).
+double stable_step_limit(const VehicleParams& p);
 
 // below this |vx| (m/s) rolling resistance and brakes fade linearly to zero, so that a
 // car at rest stays exactly at rest; chosen from dt for RK4 stability (see vehicle.cc)

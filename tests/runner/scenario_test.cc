@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "sim/runner/files.h"
 #include "sim/runner/ini.h"
@@ -153,6 +154,29 @@ TEST(Scenario, ResolvedFileReadsBackToTheSameScenario) {
   fs::remove(p);
 }
 
+TEST_F(ScenarioFile, AVehicleOutsideThePhysicalRangeOrTooLargeAStepIsRejectedAtLoad) {
+  // values that used to pass and then drove the state to NaN (or passed in silence)
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[vehicle]\nmass = 0.001\n")),
+              HasSubstr(":5: [vehicle] mass = 0.001 is out of range; expected in [50, 2000] kg"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[vehicle]\nmass = 1e308\n")), HasSubstr("[vehicle] mass = 1e308 is out of range"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[vehicle]\ninertia_z = 1e-300\n")), HasSubstr("[vehicle] inertia_z"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[vehicle]\ntyre_d = 1e6\n")), HasSubstr("[vehicle] tyre_d"));
+  // the default car's tyre modes: ~183 1/s at 1.5 m/s, so 10 Hz is unstable and 100 Hz is not
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[sim]\nphysics_rate = 10\ncontrol_rate = 10\nlog_rate = 10\n")),
+              HasSubstr("[sim] physics_rate must be at least 74 Hz for this vehicle"));
+  EXPECT_EQ(error_of(write(std::string(kHead) + "[sim]\nphysics_rate = 100\n")), "(no error)");
+}
+
+TEST(Scenario, TheStableStepLimitIsTheLinearModelsFastestMode) {
+  // recomputed by hand for the default car: C = B C D m g / 2 per axle
+  const Scenario s = load_scenario(kDefault);
+  const vehicle::VehicleParams& v = s.vehicle;
+  const double c_axle = v.tyre_b * v.tyre_c * v.tyre_d * v.mass * kGravity * 0.5;
+  const double lateral = 2.0 * c_axle / (v.mass * 1.5), yaw = 2.0 * c_axle * v.lf * v.lf / (v.inertia_z * 1.5);
+  EXPECT_NEAR(vehicle::stable_step_limit(v), 2.5 / std::max(lateral, yaw), 1e-12);
+  EXPECT_NEAR(vehicle::stable_step_limit(v), 0.0136, 0.0003);
+}
+
 TEST_F(ScenarioFile, AnOldKeyNamesItsNewPlace) {
   EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nstanley_k = 2\n")),
               HasSubstr(":5: unknown key 'stanley_k' in [control]; it is now [control.stanley] k"));
@@ -241,8 +265,19 @@ TEST(Scenario, TheReadmesTableOfKeysIsCurrent) {
   const auto a = readme.find(begin), b = readme.find(end);
   ASSERT_NE(a, std::string::npos);
   ASSERT_NE(b, std::string::npos);
-  EXPECT_EQ(readme.substr(a + begin.size(), b - a - begin.size()), "\n" + keys_markdown() + "\n")
-      << "run ./paddock keys and paste its table into the README between the markers";
+  // the first line that differs, to say which key is stale
+  std::istringstream in_readme(readme.substr(a + begin.size(), b - a - begin.size())), in_keys("\n" + keys_markdown() + "\n");
+  std::string x, y;
+  int line = 0;
+  bool same = true;
+  while (same) {
+    const bool more_x = static_cast<bool>(std::getline(in_readme, x)), more_y = static_cast<bool>(std::getline(in_keys, y));
+    ++line;
+    if (!more_x && !more_y) break;
+    same = more_x == more_y && x == y;
+  }
+  EXPECT_TRUE(same) << "line " << line << " of the README's table is\n  " << x << "\nbut ./paddock keys prints\n  " << y
+                    << "\nrun ./paddock keys and paste its table into the README between the markers";
 }
 
 }  // namespace

@@ -155,7 +155,7 @@ TEST(VehicleParams, DefaultIniSetsEveryFieldAndValidates) {
 TEST(VehicleParams, ValidateNamesTheFieldAndWhatWasExpected) {
   VehicleParams p = defaults();
   p.mass = -1.0;
-  EXPECT_EQ(params::validate(p), "mass must be > 0 kg (got -1)");
+  EXPECT_EQ(params::validate(p), "mass must be in [50, 2000] kg (got -1)");
 
   p = defaults();
   p.aero_balance_front = 1.5;
@@ -172,10 +172,10 @@ TEST(VehicleParams, ValidateNamesTheFieldAndWhatWasExpected) {
   // a field left unset (NaN) is named
   p = defaults();
   p.brake_force_max = kUnset;
-  EXPECT_EQ(params::validate(p), "brake_force_max must be >= 0 N (got nan)");
+  EXPECT_EQ(params::validate(p), "brake_force_max must be in [0, 20000] N (got nan)");
 
   // a default-constructed set is rejected at its first field
-  EXPECT_EQ(params::validate(VehicleParams{}), "mass must be > 0 kg (got nan)");
+  EXPECT_EQ(params::validate(VehicleParams{}), "mass must be in [50, 2000] kg (got nan)");
 }
 
 // ---------------------------------------------------------------------------
