@@ -25,6 +25,19 @@ inline double tyre_mu(const VehicleParams& p, double alpha) {
 double tyre_lateral_force(const VehicleParams& p, double alpha, double fz) { return -tyre_mu(p, alpha) * fz; }
 
 // FSSIM: lambda = clamp(0.5 (|v| - 1.5), 0, 1)
+// the slip angle of a wheel whose rolling direction points at `steer` in the
+// body frame, its contact point moving at (vx, vy): phi = atan2(vy, vx) -
+// steer, the velocity's angle from the rolling direction. A wheel rolling
+// backwards (cos phi < 0) slips by the angle from its backward direction,
+// pi - phi folded into (-pi/2, pi/2]: the force -mu(alpha) Fz then still
+// opposes the lateral velocity (atan2 alone gives +-pi there, flipping sign
+// from step to step, and a spun car drove itself backwards for ever)
+double slip_angle(double vx, double vy, double steer) {
+  const double phi = std::atan2(vy, vx) - steer;
+  if (std::cos(phi) >= 0.0) return phi;
+  return wrap_angle(kPi - phi);
+}
+
 double dynamic_weight(double speed_abs) { return std::clamp(0.5 * (speed_abs - 1.5), 0.0, 1.0); }
 
 // ---------------------------------------------------------------------------
@@ -183,8 +196,8 @@ Deriv derivative(const Model& m, const X& s) {
   // lateral tyre forces, only where the dynamic model has weight (no slip angle at rest)
   double fy_f = 0.0, fy_r = 0.0;
   if (lambda > 0.0) {
-    const double alpha_f = std::atan2(s.vy + p.lf * s.r, s.vx) - s.steer;
-    const double alpha_r = std::atan2(s.vy - p.lr * s.r, s.vx);
+    const double alpha_f = slip_angle(s.vx, s.vy + p.lf * s.r, s.steer);
+    const double alpha_r = slip_angle(s.vx, s.vy - p.lr * s.r, 0.0);
     fy_f = -tyre_mu(p, alpha_f) * fz_f;
     fy_r = -tyre_mu(p, alpha_r) * fz_r;
   }

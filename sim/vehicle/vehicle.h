@@ -158,6 +158,12 @@ double tyre_lateral_force(const VehicleParams& p, double alpha, double fz);
 // weight of the dynamic model in the low-speed blend: clamp(0.5 (|v| - 1.5), 0, 1)
 double dynamic_weight(double speed);
 
+// the slip angle (rad) of a wheel rolling at `steer` (rad, body frame) whose
+// contact point moves at (vx, vy) (body frame): atan2(vy, vx) - steer rolling
+// forwards, the angle from the backward direction rolling backwards; always
+// in (-pi/2, pi/2] when |steer| < pi/2
+double slip_angle(double vx, double vy, double steer);
+
 // the longest physics step (s) the explicit RK4 integration stays stable at
 // for this car: 2.5 / lambda, lambda the faster of the linear single-track
 // model's lateral and yaw modes at the speed where the dynamic model starts

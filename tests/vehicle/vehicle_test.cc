@@ -346,6 +346,40 @@ TEST(Longitudinal, BrakingInACornerStopsAndStopsTurning) {
   EXPECT_NEAR(s.y, stopped.y, 1e-9);
 }
 
+TEST(Lateral, SlipAngleOpposesTheLateralVelocityInEveryDirectionOfTravel) {
+  // forwards it is the textbook atan2(vy, vx) - steer, to the bit
+  EXPECT_EQ(slip_angle(10.0, 1.0, 0.1), std::atan2(1.0, 10.0) - 0.1);
+  // backwards: the same magnitude as forwards, its sign that of the lateral velocity
+  EXPECT_NEAR(slip_angle(-10.0, 1.0, 0.0), std::atan(1.0 / 10.0), 1e-12);
+  EXPECT_NEAR(slip_angle(-10.0, -1.0, 0.0), -std::atan(1.0 / 10.0), 1e-12);
+  // a steered wheel rolling backwards: the velocity in the wheel frame, by rotation
+  for (const double steer : {-0.5, -0.1, 0.2, 0.5}) {
+    for (const double vy : {-3.0, -0.2, 0.0, 0.7, 4.0}) {
+      const double v_long = -6.0 * std::cos(steer) + vy * std::sin(steer);
+      const double v_lat = 6.0 * std::sin(steer) + vy * std::cos(steer);
+      EXPECT_NEAR(slip_angle(-6.0, vy, steer), std::atan(v_lat / std::abs(v_long)), 1e-12) << steer << " " << vy;
+      EXPECT_LE(std::abs(slip_angle(-6.0, vy, steer)), kPi / 2);
+    }
+  }
+}
+
+TEST(Lateral, ASpunCarComesToRest) {
+  // straight at 20 m/s, full lock held, no throttle, no brake: the car spins
+  // and must then stop under drag and rolling resistance (it used to travel
+  // backwards at 3.46 m/s for as long as the run lasted)
+  const VehicleParams& p = defaults();
+  VehicleState s = moving_state(p, 20.0);
+  const DriverInput in{p.steering_max, 0.0, 0.0};
+  double min_vx = 0.0;
+  for (int k = 0; k < 60000; ++k) {
+    step(p, s, in, kDt);
+    min_vx = std::min(min_vx, s.vx);
+  }
+  EXPECT_LT(min_vx, -1.0) << "the car did not spin: the test tests nothing";
+  EXPECT_LT(std::hypot(s.vx, s.vy), 0.05) << "vx " << s.vx << " vy " << s.vy;
+  EXPECT_LT(std::abs(s.r), 0.05);
+}
+
 TEST(Longitudinal, SpeedIsConservedWithoutForces) {
   // no drive, brake, drag or rolling resistance: on a straight line nothing acts
   VehicleParams p = defaults();
