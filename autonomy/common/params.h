@@ -165,6 +165,40 @@ class Validator {
   std::string prefix_;  // the path of the section being visited, with a trailing '.'
 };
 
+// the path of every field of p (and of the structs nested in it), in
+// declaration order: "tolerance", "ground.max_slope", ...
+class PathLister {
+ public:
+  std::vector<std::string> paths;
+
+  template <class T>
+  void operator()(const char* key, T&, const Spec&) { add(key); }
+  template <class E, std::size_t N>
+  void operator()(const char* key, E&, const Choice<E> (&)[N], const char*) { add(key); }
+  void operator()(const char* key, bool&, const char*) { add(key); }
+  void operator()(const char* key, std::optional<bool>&, const char*) { add(key); }
+  void operator()(const char* key, std::string&, const char*) { add(key); }
+  template <class P>
+  void section(const char* key, P& sub, const char*) {
+    const std::size_t size = prefix_.size();
+    prefix_ += key;
+    prefix_ += '.';
+    sub.visit(*this);
+    prefix_.resize(size);
+  }
+
+ private:
+  void add(const char* key) { paths.push_back(prefix_ + key); }
+  std::string prefix_;
+};
+
+template <class P>
+std::vector<std::string> field_paths(const P& p) {
+  PathLister l;
+  const_cast<P&>(p).visit(l);  // reads only
+  return l.paths;
+}
+
 // "" when every field of p (and of every struct nested in it) lies in its
 // bounds and every check() passes, else the first problem, starting with the
 // field's path ("clustering.tolerance must be > 0 m (got -1)")

@@ -196,8 +196,9 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   as_used.planning = stack.planning;
   as_used.skidpad = stack.skidpad;
   if (const std::string why = params::validate(as_used); !why.empty()) throw UserError(path + ": " + as_section_key(why));
-  if (const std::string why = params::validate(stack); !why.empty()) {
-    throw UserError(path + ": the stack's parameters as derived from the scenario: " + why);
+  // and what the stack knows of its car (the rest of its parameters is as_used's)
+  if (const std::string why = params::validate(stack.vehicle); !why.empty()) {
+    throw UserError(path + ": [vehicle] what the stack knows of the car: " + why);
   }
   s.source = path;
   s.name = std::filesystem::path(path).stem().string();

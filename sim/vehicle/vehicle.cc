@@ -28,13 +28,14 @@ double tyre_lateral_force(const VehicleParams& p, double alpha, double fz) { ret
 // the slip angle of a wheel whose rolling direction points at `steer` in the
 // body frame, its contact point moving at (vx, vy): phi = atan2(vy, vx) -
 // steer, the velocity's angle from the rolling direction. A wheel rolling
-// backwards (cos phi < 0) slips by the angle from its backward direction,
+// backwards (|phi| > pi/2) slips by the angle from its backward direction,
 // pi - phi folded into (-pi/2, pi/2]: the force -mu(alpha) Fz then still
 // opposes the lateral velocity (atan2 alone gives +-pi there, flipping sign
 // from step to step, and a spun car drove itself backwards for ever)
 double slip_angle(double vx, double vy, double steer) {
   const double phi = std::atan2(vy, vx) - steer;
-  if (std::cos(phi) >= 0.0) return phi;
+  // |phi| < 3 pi / 2 for |steer| < pi / 2: rolling forwards is |phi| <= pi / 2 (no cos in the hot path)
+  if (std::abs(phi) <= 0.5 * kPi) return phi;
   return wrap_angle(kPi - phi);
 }
 

@@ -268,32 +268,12 @@ TEST(Stack, AGateSeenOnlyAfterTheCarCrossedItCounts) {
   EXPECT_EQ(s.gates().size(), 2u);
 }
 
-// the paths a visitor sees in a whole stack's parameters
-struct PathLister {
-  std::vector<std::string> paths;
-  std::string prefix;
-  template <class T>
-  void operator()(const char* key, T&, const params::Spec&) { paths.push_back(prefix + key); }
-  template <class E, std::size_t N>
-  void operator()(const char* key, E&, const params::Choice<E> (&)[N], const char*) { paths.push_back(prefix + key); }
-  void operator()(const char* key, bool&, const char*) { paths.push_back(prefix + key); }
-  template <class P>
-  void section(const char* key, P& p, const char*) {
-    const std::string saved = prefix;
-    prefix += std::string(key) + ".";
-    p.visit(*this);
-    prefix = saved;
-  }
-};
-
 TEST(StackParams, EveryParameterHasOnePathAndWhatTheRunnerFillsHasNone) {
-  StackParams p;
-  PathLister l;
-  p.visit(l);
-  std::vector<std::string> sorted = l.paths;
+  const std::vector<std::string> paths = params::field_paths(StackParams{});
+  std::vector<std::string> sorted = paths;
   std::sort(sorted.begin(), sorted.end());
   EXPECT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end());
-  const auto has = [&](const std::string& path) { return std::count(l.paths.begin(), l.paths.end(), path) == 1; };
+  const auto has = [&](const std::string& path) { return std::count(paths.begin(), paths.end(), path) == 1; };
   for (const char* path : {"autonomy.perception", "autonomy.slam", "autonomy.planner", "perception.odometry.history",
                            "perception.lidar.ground.max_slope", "perception.lidar.clustering.tolerance",
                            "perception.fusion.camera_range", "perception.camera_sync_tolerance",
