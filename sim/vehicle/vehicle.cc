@@ -286,6 +286,12 @@ VehicleState initial_state(const VehicleParams& p, Pose2 base_pose_in) {
   return s;
 }
 
+VehicleState rolling_state(const VehicleParams& p, Pose2 base_pose_in, double speed) {
+  VehicleState s = initial_state(p, base_pose_in);
+  s.vx = speed;
+  return s;
+}
+
 void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
   assert(dt > 0.0);
 

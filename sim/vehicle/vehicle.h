@@ -148,6 +148,10 @@ bool is_finite(const VehicleState& s);
 // the state at rest with the base frame (rear axle centre on the ground) at base_pose
 VehicleState initial_state(const VehicleParams& p, Pose2 base_pose);
 
+// the state driving straight ahead at `speed` (m/s, CG) with the base frame at
+// base_pose: every wheel rolling at that speed, actuators at rest
+VehicleState rolling_state(const VehicleParams& p, Pose2 base_pose, double speed);
+
 // one fixed step of length dt (s): RK4 over the whole state (rigid body and actuators)
 void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt);
 

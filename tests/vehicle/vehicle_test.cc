@@ -87,11 +87,7 @@ VehicleParams instant_actuators() {
   return p;
 }
 
-VehicleState moving_state(const VehicleParams& p, double vx) {
-  VehicleState s = initial_state(p, Pose2{});
-  s.vx = vx;
-  return s;
-}
+VehicleState moving_state(const VehicleParams& p, double vx) { return rolling_state(p, Pose2{}, vx); }
 
 // run at a constant steering angle with a speed controller (feedforward against drag
 // and rolling resistance + proportional), return the final state
