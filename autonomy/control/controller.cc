@@ -9,10 +9,11 @@ namespace {
 
 SpeedModel speed_model_of(const VehicleKnowledge& v) {
   SpeedModel m;
-  m.mass = v.mass;
+  m.mass = v.equivalent_mass;
   m.drag_coefficient = v.drag_coefficient;
   m.rolling_resistance = v.rolling_resistance;
   m.max_drive_force = v.max_drive_force;
+  m.max_drive_power = v.max_drive_power;
   m.max_brake_force = v.max_brake_force;
   return m;
 }
@@ -159,6 +160,7 @@ ControlOutput Controller::update(const ControlInput& in) {
     // the cap rules: feed forward its own slope (the mission's ramp down)
     const bool slope_known = have_hint_ && last_cap_finite_ && in.dt > 0.0;
     a_ref = slope_known ? std::min((cap - last_cap_) / in.dt, 0.0) : 0.0;
+    speed_.release_drive();
   }
   d.v_ref = cap_active ? cap : v_traj;
   d.a_ref = a_ref;

@@ -23,6 +23,9 @@ namespace paddock::control {
 // the visit below gives the units and bounds params::validate checks.
 struct VehicleKnowledge {
   double mass = 190.0;
+  // the mass the drive accelerates: the car's plus its wheels' and motors'
+  // rotating inertia seen at the road, sum I / r^2
+  double equivalent_mass = 190.0;
   double lf = 0.765;
   double lr = 0.765;
   double wheelbase = 1.53;
@@ -33,6 +36,9 @@ struct VehicleKnowledge {
   // kinematically; EUFS has +-0.52
   double max_steering_angle = 0.5;
   double max_drive_force = 5000.0;
+  // what the motors deliver to the wheels above the base speed: the drive
+  // force at throttle 1 is min(max_drive_force, max_drive_power / v)
+  double max_drive_power = 1e12;
   // about what the tyres carry without downforce, D m g = 1.6 * 190 * 9.81
   double max_brake_force = 3000.0;
   double drag_coefficient = 0.7;
@@ -41,12 +47,14 @@ struct VehicleKnowledge {
   template <class V>
   void visit(V& v) {
     v(PADDOCK_PARAM(mass), {"kg", params::above(0.0), "the car's mass"});
+    v(PADDOCK_PARAM(equivalent_mass), {"kg", params::above(0.0), "mass plus the rotating parts seen at the road (what the drive accelerates)"});
     v(PADDOCK_PARAM(lf), {"m", params::above(0.0), "CG to front axle"});
     v(PADDOCK_PARAM(lr), {"m", params::above(0.0), "CG to rear axle"});
     v(PADDOCK_PARAM(wheelbase), {"m", params::above(0.0), "rear axle to front axle (lf + lr)"});
     v(PADDOCK_PARAM(front_cornering_stiffness), {"N/rad", params::above(0.0), "front axle cornering stiffness"});
     v(PADDOCK_PARAM(max_steering_angle), {"rad", params::Bounds{0.0, 0.5 * kPi, true, true}, "largest steering angle at the wheels"});
-    v(PADDOCK_PARAM(max_drive_force), {"N", params::above(0.0), "drive force at throttle 1"});
+    v(PADDOCK_PARAM(max_drive_force), {"N", params::above(0.0), "drive force at throttle 1 below the base speed"});
+    v(PADDOCK_PARAM(max_drive_power), {"W", params::above(0.0), "drive power at the wheels at throttle 1 above the base speed"});
     v(PADDOCK_PARAM(max_brake_force), {"N", params::above(0.0), "brake force at brake 1"});
     v(PADDOCK_PARAM(drag_coefficient), {"N s^2/m^2", params::at_least(0.0), "aerodynamic drag F = c v^2"});
     v(PADDOCK_PARAM(rolling_resistance), {"N", params::at_least(0.0), "constant resistance while moving"});

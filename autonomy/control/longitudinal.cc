@@ -7,9 +7,12 @@ namespace paddock::control {
 
 namespace {
 
-// the signed pedal of a force demand: > 0 throttle, < 0 brake, unclamped
-double pedal(double force, const SpeedModel& m) {
-  return force >= 0.0 ? force / m.max_drive_force : force / m.max_brake_force;
+// the signed pedal of a force demand at speed v: > 0 throttle (of the
+// motor's envelope at v), < 0 brake, unclamped
+double pedal(double force, double v, const SpeedModel& m) {
+  if (force < 0.0) return force / m.max_brake_force;
+  const double drive = v > 0.0 ? std::min(m.max_drive_force, m.max_drive_power / v) : m.max_drive_force;
+  return force / drive;
 }
 
 }  // namespace
@@ -26,6 +29,7 @@ LongitudinalCommand SpeedController::update(double v_ref, double a_ref, double v
     out.holding = true;
     return out;
   }
+  if (v_ref <= 0.0) release_drive();
 
   // model feedforward: the force that would hold the reference acceleration
   // against the drag (of the measured speed) and the rolling resistance
@@ -43,7 +47,7 @@ LongitudinalCommand SpeedController::update(double v_ref, double a_ref, double v
   //    zero), and the speed would then overshoot and creep back for seconds.
   // The clamp |I| <= integral_limit still bounds what it can learn.
   const double e = v_ref - v;
-  const double u_before = pedal(f_ff + m.mass * (p.kp * e + integral_), m);
+  const double u_before = pedal(f_ff + m.mass * (p.kp * e + integral_), v, m);
   const bool pushes_high = u_before >= 1.0 && e > 0.0;
   const bool pushes_low = u_before <= -1.0 && e < 0.0;
   const bool in_band = std::abs(e) < p.integral_band;
@@ -54,7 +58,7 @@ LongitudinalCommand SpeedController::update(double v_ref, double a_ref, double v
   // feedback plus feedforward, then the pedal map
   out.accel_demand = p.kp * e + integral_;
   out.force_demand = f_ff + m.mass * out.accel_demand;
-  const double u = pedal(out.force_demand, m);
+  const double u = pedal(out.force_demand, v, m);
   out.throttle = std::clamp(u, 0.0, 1.0);
   out.brake = std::clamp(-u, 0.0, 1.0);
   return out;

@@ -10,10 +10,13 @@
 // becomes a force with the feedforward of the reference acceleration and the
 // resistances,
 //   F = m a_cmd + g_ff (m a_ref + c_drag v^2 + F_roll),
-// and the force becomes a pedal: u = F / F_drive,max when F > 0 (throttle),
+// and the force becomes a pedal: u = F / F_drive,max(v) when F > 0 (throttle;
+// F_drive,max(v) = min(F_drive,max, P_drive,max / v), the motor's envelope),
 // u = F / F_brake,max when F < 0 (brake), each clamped to [0, 1]. Gains in
 // acceleration units keep their meaning when the car's mass or motor changes,
 // and the separate force scales are the separate throttle and brake gains.
+#include <algorithm>
+
 #include "autonomy/common/params.h"
 
 namespace paddock::control {
@@ -50,7 +53,8 @@ struct SpeedModel {
   double mass = 190.0;                // kg
   double drag_coefficient = 0.7;      // F_drag = c v^2 (N s^2/m^2)
   double rolling_resistance = 180.0;  // constant resistance while moving (N)
-  double max_drive_force = 5000.0;    // force at throttle 1 (N)
+  double max_drive_force = 5000.0;    // force at throttle 1 below the base speed (N)
+  double max_drive_power = 1e12;      // power at throttle 1 above it (W): the force is min(F, P / v)
   double max_brake_force = 3000.0;    // force at brake 1 (N)
 };
 
@@ -69,6 +73,9 @@ class SpeedController {
   LongitudinalCommand update(double v_ref, double a_ref, double v, double dt,
                              const LongitudinalParams& p, const SpeedModel& m);
   void reset() { integral_ = 0.0; }
+  // a stop: what the integrator learned of the car's losses while driving
+  // (drive held against cornering drag) must not hold the car against it
+  void release_drive() { integral_ = std::min(integral_, 0.0); }
   double integral() const { return integral_; }  // I (m/s^2)
 
  private:

@@ -51,9 +51,12 @@ struct VelocityProfileParams {
   // of the lateral grip a turn uses, the less of the longitudinal limit is
   // assumed available (a more conservative g-g shape in combined slip, where
   // real tyres and a tracking controller fall short of the ideal ellipse).
-  // Default 0.5: in a turn at the lateral limit, half the straight-line
-  // acceleration and braking is planned.
-  double turn_accel_scale = 0.5;
+  // Default 0.4: in a turn at the lateral limit, 40 % of the straight-line
+  // acceleration and braking is planned (0.5 before the car's tyres shared
+  // their grip between drive and cornering: with combined slip a hairpin
+  // exit at half the straight-line acceleration slid wide enough to hit
+  // cones).
+  double turn_accel_scale = 0.4;
 
   template <class V>
   void visit(V& v) {

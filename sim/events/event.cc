@@ -83,6 +83,7 @@ void Event::crossed(double t, std::size_t gate, Vec2 where) {
     lap.time = t - lap_start_;
     lap.doo = last_doo_total_ - doo_at_lap_start_;
     lap.oc = oc_in_lap_;
+    lap.energy = energy_ - energy_at_lap_start_;
     lap.timed = rules_.timed_laps.empty();
     for (int n : rules_.timed_laps) lap.timed = lap.timed || n == lap.number;
     result_.laps.push_back(lap);
@@ -99,6 +100,7 @@ void Event::crossed(double t, std::size_t gate, Vec2 where) {
   if (!lap_running_ && gate == start_gate) {
     lap_running_ = true;
     lap_start_ = t;
+    energy_at_lap_start_ = energy_;
   }
 }
 
@@ -106,6 +108,7 @@ void Event::on_sample(const CarSample& s) {
   if (done_) return;
   last_doo_total_ = s.doo_total;
   result_.doo = s.doo_total;
+  energy_ = s.energy;
 
   if (s.as_emergency) return finish_run(false, "the car went to AS Emergency", s.t);
   if (!go_time_) return;

@@ -52,6 +52,7 @@ struct Lap {
   bool timed = true;     // counts towards the score
   int doo = 0;           // cones down or out during this lap
   int oc = 0;            // off-course excursions that began during this lap
+  double energy = 0.0;   // drawn from the accumulator during the lap, regeneration counted off (J)
 };
 
 struct Result {
@@ -75,6 +76,7 @@ struct CarSample {
   bool as_finished = false;        // the car reports AS Finished
   bool as_emergency = false;       // the car reports AS Emergency
   int doo_total = 0;               // cones down or out so far (the world counts them)
+  double energy = 0.0;             // drawn from the accumulator so far, regeneration counted off (J)
 };
 
 class Event {
@@ -112,6 +114,8 @@ class Event {
   std::optional<double> go_time_;
   bool lap_running_ = false;
   double lap_start_ = 0.0;
+  double energy_ = 0.0;             // the car's energy counter at the last sample (J)
+  double energy_at_lap_start_ = 0.0;
   bool crossed_finish_ = false;     // all laps done: the car must now stop
   double finish_cross_time_ = 0.0;
   Vec2 finish_cross_point_;

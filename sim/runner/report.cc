@@ -58,13 +58,13 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
   const events::Rules rules = events::rules_for(s.scenario.event);
   o << s.name << ": " << events::to_string(s.scenario.event) << " on " << s.track_path << "\n";
   o << "  result      " << (ev.finished ? "finished" : "DNF: " + ev.dnf_reason) << "\n";
-  o << "  lap     time [s]   DOO  OC   rms [m]  max [m]  ITAE\n";
+  o << "  lap     time [s]   DOO  OC   rms [m]  max [m]  ITAE   energy [Wh]\n";
   for (std::size_t i = 0; i < ev.laps.size(); ++i) {
     const auto& lap = ev.laps[i];
     const auto& tr = r.lap_tracking[i];
     char buf[160];
-    std::snprintf(buf, sizeof buf, "  %3d%s %9.3f   %3d %3d   %7.3f  %7.3f  %7.1f\n", lap.number, lap.timed ? " " : "*",
-                  lap.time, lap.doo, lap.oc, tr.rms, tr.max, tr.itae);
+    std::snprintf(buf, sizeof buf, "  %3d%s %9.3f   %3d %3d   %7.3f  %7.3f  %7.1f  %8.1f\n", lap.number,
+                  lap.timed ? " " : "*", lap.time, lap.doo, lap.oc, tr.rms, tr.max, tr.itae, lap.energy / 3600.0);
     o << buf;
   }
   if (!rules.timed_laps.empty()) o << "  (* untimed lap)\n";
@@ -78,6 +78,7 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
     << ", total " << fixed(ev.total_time, 3) << " s\n";
   o << "  tracking    rms " << fixed(r.tracking.rms, 3) << " m, max " << fixed(r.tracking.max, 3) << " m, ITAE "
     << fixed(r.tracking.itae, 1) << " (mean per lap)\n";
+  o << "  energy      " << fixed(r.energy / 3600.0, 1) << " Wh drawn from the accumulator over the run (regeneration counted off)\n";
   if (r.perception.frames() > 0) {
     o << "  perception  " << stack::to_string(s.autonomy.perception) << ", " << r.perception.frames()
       << " frames against the truth (recall over the cones the sensor "
@@ -120,7 +121,8 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
     const auto& lap = ev.laps[i];
     const auto& tr = r.lap_tracking[i];
     laps.push_back({{"lap", lap.number}, {"start", lap.start}, {"time", lap.time}, {"timed", lap.timed},
-                    {"doo", lap.doo}, {"oc", lap.oc}, {"tracking", tracking(tr.rms, tr.max, tr.itae)}});
+                    {"doo", lap.doo}, {"oc", lap.oc}, {"tracking", tracking(tr.rms, tr.max, tr.itae)},
+                    {"energy", lap.energy}});
   }
   Json cones = Json::array();
   for (const ConeHit& c : r.cones_hit) {
@@ -165,6 +167,7 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"wall_time", r.wall_time},
       {"realtime_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0},
       {"tracking", tracking(r.tracking.rms, r.tracking.max, r.tracking.itae)},
+      {"energy", r.energy},
       {"perception", perception},
       {"stack", {{"fallbacks", r.fallbacks}, {"fault", r.fault}}},
       {"expectations_failed", failed},

@@ -259,12 +259,14 @@ stack::StackParams stack_params(const Scenario& s) {
   const vehicle::VehicleParams& v = s.vehicle;
   control::VehicleKnowledge& k = p.vehicle;
   k.mass = v.mass;
+  k.equivalent_mass = vehicle::equivalent_mass(v);
   k.lf = v.lf;
   k.lr = v.lr;
   k.wheelbase = v.lf + v.lr;
   k.front_cornering_stiffness = control::front_axle_cornering_stiffness(v.tyre_b, v.tyre_c, v.tyre_d, v.mass, v.lf, v.lr);
   k.max_steering_angle = v.steering_max;
-  k.max_drive_force = v.cm1;
+  k.max_drive_force = vehicle::drive_torque_limit(v, 0.0) / v.wheel_radius;
+  k.max_drive_power = vehicle::drive_power_limit(v);
   k.max_brake_force = v.brake_force_max;
   k.drag_coefficient = v.c_drag;
   k.rolling_resistance = v.cr0;

@@ -75,6 +75,7 @@ void sample(const SimModel& model, SimState& s, const Pose2& base) {
   c.as_finished = s.as_state == hal::AsState::Finished;
   c.as_emergency = s.as_state == hal::AsState::Emergency;
   c.doo_total = s.cones.doo_count();
+  c.energy = s.car.energy;
   s.event.on_sample(c);
   s.done = s.event.done();
 }
@@ -114,6 +115,7 @@ RunResult results_of(const SimState& s) {
   r.fallbacks = s.stack.telemetry().fallbacks;
   r.fault = s.stack.telemetry().last_fault;
   r.cycles = s.control_cycles;
+  r.energy = s.car.energy;
   const planning::PlanResult& plan = s.stack.last_plan();
   const std::vector<Cone>& plan_cones = s.stack.last_plan_cones();
   for (const planning::TriEdge& e : plan.triangulation.edges) {

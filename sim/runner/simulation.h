@@ -112,6 +112,7 @@ struct RunResult {
   std::vector<LogRow> log;
   double sim_time = 0.0;   // s
   double wall_time = 0.0;  // s
+  double energy = 0.0;     // J drawn from the accumulator over the run, regeneration counted off
   int fallbacks = 0;       // control cycles in the safe stop
   std::string fault;       // the stack's last fault, if any
   int cycles = 0;          // control cycles run

@@ -7,159 +7,238 @@
 namespace paddock::vehicle {
 
 // ---------------------------------------------------------------------------
-// tyre and blend
+// tyre and motor
 // ---------------------------------------------------------------------------
 
-// Pacejka magic formula, lateral, without shifts:
-//   mu_y(a) = D sin(C atan(B a - E (B a - atan(B a))))
-//   Fy      = -mu_y(a) Fz      (the force opposes the slip angle)
-// FSSIM writes the same curve as D sin(C atan(B (1 - E) a + E atan(B a))) with C = -1.38,
-// which folds the minus sign into C (sin and atan are odd).
 namespace {
-inline double tyre_mu(const VehicleParams& p, double alpha) {
-  const double ba = p.tyre_b * alpha;
-  return p.tyre_d * std::sin(p.tyre_c * std::atan(ba - p.tyre_e * (ba - std::atan(ba))));
+
+// a wheel turning slower than this (rad/s) counts as at rest for its friction
+// torques (brakes, rolling resistance): they hold it instead of turning it back
+constexpr double kRestSpin = 1e-3;
+// the low-speed damping of the tyre deflections fades out up to this contact speed (m/s)
+constexpr double kLowSpeed = 2.0;
+// its damping ratio against a quarter of the car on the tyre's stiffness
+constexpr double kLowSpeedDamping = 0.3;
+// the largest normalised slip B kappa, B alpha the deflections carry: a sliding
+// tyre's deflection stops growing there (2.3x the peak of the gotthard curve,
+// g = 0.94 of the peak), so a car that stops sliding keeps only a few cm of it
+constexpr double kSlipCap = 4.0;
+// the motor torque fades to 0 over this share of the motor speed range
+constexpr double kMotorFade = 0.05;
+// traction control: the slip ratio's speed floor (m/s; a launch from rest lets
+// the wheels slip by kappa* x this), and the band over which the torque is cut
+constexpr double kTractionSpeedFloor = 3.0;
+constexpr double kTractionBand = 2.0;  // x traction_control_slip
+// the brake plausibility check (FS rules EV 2.3): braking (a brake command of
+// at least kPlausibilityBrake) with more than 25 % throttle cuts the motor
+// torque until the throttle falls below 5 %
+constexpr double kPlausibilityBrake = 0.1;
+constexpr double kPlausibilityCut = 0.25;
+constexpr double kPlausibilityReset = 0.05;
+// regeneration fades in between these wheel speeds (m/s): 5 and 10 km/h
+constexpr double kRegenOff = 5.0 / 3.6;
+constexpr double kRegenFull = 10.0 / 3.6;
+
+// Pacejka's curve without shifts: g(X) = sin(C atan(X - E (X - atan X))); g'(0) = C
+inline double mf_shape(const VehicleParams& p, double x) {
+  return std::sin(p.tyre_c * std::atan(x - p.tyre_e * (x - std::atan(x))));
 }
+
+inline double sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
+
+// a wheel's share of the drive torque: the axle's, split equally left and right
+double drive_share(const VehicleParams& p, std::size_t i) {
+  return 0.5 * (i < 2 ? p.drive_split_front : 1.0 - p.drive_split_front);
+}
+
+// a wheel's spin inertia: its own, and a driven wheel's motor and gears
+double wheel_inertia_of(const VehicleParams& p, std::size_t i) {
+  return p.wheel_inertia + (drive_share(p, i) > 0.0 ? p.driveline_inertia : 0.0);
+}
+
 }  // namespace
 
-double tyre_lateral_force(const VehicleParams& p, double alpha, double fz) { return -tyre_mu(p, alpha) * fz; }
-
-// FSSIM: lambda = clamp(0.5 (|v| - 1.5), 0, 1)
-// the slip angle of a wheel whose rolling direction points at `steer` in the
-// body frame, its contact point moving at (vx, vy): phi = atan2(vy, vx) -
-// steer, the velocity's angle from the rolling direction. A wheel rolling
-// backwards (|phi| > pi/2) slips by the angle from its backward direction,
-// pi - phi folded into (-pi/2, pi/2]: the force -mu(alpha) Fz then still
-// opposes the lateral velocity (atan2 alone gives +-pi there, flipping sign
-// from step to step, and a spun car drove itself backwards for ever)
-double slip_angle(double vx, double vy, double steer) {
-  const double phi = std::atan2(vy, vx) - steer;
-  // |phi| < 3 pi / 2 for |steer| < pi / 2: rolling forwards is |phi| <= pi / 2 (no cos in the hot path)
-  if (std::abs(phi) <= 0.5 * kPi) return phi;
-  return wrap_angle(kPi - phi);
+double load_factor(const VehicleParams& p, double fz) {
+  return std::max(0.0, 1.0 + p.tyre_load_sensitivity * (fz / p.tyre_load_nominal - 1.0));
 }
 
-double dynamic_weight(double speed_abs) { return std::clamp(0.5 * (speed_abs - 1.5), 0.0, 1.0); }
+TyreForce tyre_force(const VehicleParams& p, double kappa, double alpha, double fz) {
+  const double xs = p.tyre_bx * kappa;
+  const double ys = p.tyre_b * alpha;
+  const double x = std::sqrt(xs * xs + ys * ys);
+  if (x == 0.0 || fz <= 0.0) return {};
+  const double k = load_factor(p, fz) * fz * mf_shape(p, x) / x;
+  return {p.tyre_dx * k * xs, -p.tyre_d * k * ys};
+}
+
+double tyre_lateral_force(const VehicleParams& p, double alpha, double fz) { return tyre_force(p, 0.0, alpha, fz).fy; }
+
+// the gears are lossless here: eta covers accumulator, inverter, motor and gears
+double drive_power_limit(const VehicleParams& p) {
+  return std::min(p.motor_power_max, p.drivetrain_efficiency * p.accumulator_power_max);
+}
+
+double drive_torque_limit(const VehicleParams& p, double wheel_speed) {
+  const double w_max = p.motor_speed_max / p.gear_ratio;
+  const double w = std::abs(wheel_speed);
+  double t = p.motor_torque_max * p.gear_ratio;
+  if (w > 0.0) t = std::min(t, drive_power_limit(p) / w);
+  return t * std::clamp((w_max - w) / (kMotorFade * w_max), 0.0, 1.0);
+}
+
+double equivalent_mass(const VehicleParams& p) {
+  double m = p.mass;
+  for (std::size_t i = 0; i < 4; ++i) m += wheel_inertia_of(p, i) / (p.wheel_radius * p.wheel_radius);
+  return m;
+}
+
+double top_speed(const VehicleParams& p) {
+  // the drive force falls and the resistance rises with v: bisect on their difference
+  auto surplus = [&](double v) {
+    return drive_torque_limit(p, v / p.wheel_radius) / p.wheel_radius - p.c_drag * v * v - p.cr0;
+  };
+  double lo = 0.0, hi = p.motor_speed_max / p.gear_ratio * p.wheel_radius;
+  if (surplus(lo) <= 0.0) return 0.0;
+  for (int i = 0; i < 80; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (surplus(mid) > 0.0 ? lo : hi) = mid;
+  }
+  return lo;
+}
 
 // ---------------------------------------------------------------------------
 // the model
 // ---------------------------------------------------------------------------
 //
-// Single-track model at the CG, body frame (x forward, y left), yaw rate r.
-// Newton in the rotating body frame: the inertial acceleration of the CG is
-//   a = d/dt (vx, vy) + r x (vx, vy) = (vx' - r vy, vy' + r vx),
-// so with the front axle forces (Fxf, Fyf) in the wheel frame, steered by delta,
-// and the rear axle forces (Fxr, Fyr) in the body frame:
-//   m (vx' - r vy) = Fxf cos(delta) - Fyf sin(delta) + Fxr + Fres
-//   m (vy' + r vx) = Fxf sin(delta) + Fyf cos(delta) + Fyr
-//   Iz r'          = lf (Fxf sin(delta) + Fyf cos(delta)) - lr Fyr
-// where Fres = -c_drag vx |vx| - Cr0 sat(vx) collects drag and rolling resistance
-// (applied at the CG along x). The pose follows from rotating the body velocity:
-//   X' = vx cos(yaw) - vy sin(yaw),  Y' = vx sin(yaw) + vy cos(yaw),  yaw' = r.
+// Chassis: a single-track model at the CG, body frame (x forward, y left),
+// yaw rate r, with the tyre forces of the four wheels (Fx_i, Fy_i in the wheel
+// frame, the front wheels steered by delta) acting at their contact points
+// (x_i, y_i) from the CG. Newton in the rotating body frame:
+//   m (vx' - r vy) = sum_i FX_i - c_drag vx |vx|
+//   m (vy' + r vx) = sum_i FY_i
+//   Iz r'          = sum_i (x_i FY_i - y_i FX_i)
+// with (FX_i, FY_i) = R(delta_i) (Fx_i, Fy_i). The pose follows from rotating
+// the body velocity: X' = vx cos(yaw) - vy sin(yaw), Y' = vx sin(yaw) + vy cos(yaw).
+// Normal loads per wheel: static + aero (per the balance) -+ half the lagged
+// longitudinal load transfer m h_cg ax / L per axle (no lateral transfer: a
+// single-track model).
 //
-// Slip angles: the axle velocities in the body frame are (vx, vy + lf r) at the
-// front and (vx, vy - lr r) at the rear; a slip angle is the angle of that velocity
-// from the wheel heading:
-//   alpha_f = atan2(vy + lf r, vx) - delta,   alpha_r = atan2(vy - lr r, vx).
-// The sideslip angle of the CG is beta = atan2(vy, vx); it is not a state here
-// (vy is), and at low speed it is undefined, which is why the slip angles are
-// evaluated only where the dynamic model has weight (|v| > 1.5 m/s).
+// Wheels: I_i omega_i' = T_drive_i - Fx_i r - T_friction_i, the friction
+// torque (brake + rolling resistance cr0 r / 4) opposing the spin; at rest it
+// holds the wheel while the other torques stay below it (static friction),
+// decided once per step (see step()).
 //
-// Kinematic model (FSSIM, no tyre slip): the rear axle moves along the body x axis
-// and the front axle along the front wheel, so with the speed of the rear axle vx
-//   r_kin = vx tan(delta) / L,   vy_kin = lr r_kin,   m vx' = Fxf + Fxr + Fres.
-// As a state derivative: vy, r track their kinematic values through
-//   r'  = d/dt r_kin  + (r_kin  - r)  / tau_kin,
-//   vy' = d/dt vy_kin + (vy_kin - vy) / tau_kin,
-//   d/dt r_kin = (vx' tan(delta) + vx delta' / cos^2(delta)) / L,
-// the first term keeps them exactly on the kinematic values once there, the second
-// pulls them there when the car enters the kinematic regime with a residual slip
-// (FSSIM overwrites them after each step, i.e. tau_kin = dt).
-// The state derivative is lambda * f_dyn + (1 - lambda) * f_kin (pose and actuator
-// rows are the same in both models).
+// Tyres: the contact point moves at (v_cx, v_cy) in the wheel frame; the
+// deflections follow first-order relaxation (Pacejka, Tyre and Vehicle
+// Dynamics, ch. 7):
+//   u_x' = (omega r - v_cx) - |v_cx| u_x / sigma_x,  kappa = u_x / sigma_x
+//   u_y' = v_cy - |v_cx| u_y / sigma_y,              alpha = atan(u_y / sigma_y)
+// In steady state kappa = (omega r - v_cx) / |v_cx| and tan(alpha) = v_cy / |v_cx|,
+// the usual slips, in every direction of travel; at low speed the tyre is a
+// spring instead of a 0/0, so no kinematic blend is needed. The tyre's stored
+// energy E = int F du only falls: dE/dt + (power of the forces on car and
+// wheel) = -F |v_cx| u / sigma <= 0, so without drive the kinetic energy never
+// grows. Below 2 m/s a damper on the contact's slip velocity (ratio 0.3 of
+// critical against a quarter of the car) settles the spring at rest.
 //
-// Normal loads per axle: static share + aero share + longitudinal load transfer
-//   Fzf = m g lr / L + bal c_down vx^2       - m ax_load h_cg / L
-//   Fzr = m g lf / L + (1 - bal) c_down vx^2 + m ax_load h_cg / L
-// The transfer uses ax_load, a state that follows the CG acceleration ax through a
-// first-order lag (the pitch dynamics of the suspension):
-//   ax_load' = (ax - ax_load) / pitch_time_constant.
-// ax depends on the normal loads (through the friction limits), so using ax itself
-// would be an algebraic loop; the lag breaks it without iteration.
-//
-// Longitudinal force per axle: motor (throttle cm1 split front/rear) minus brake
-// (brake F_brake_max split front/rear, opposing vx), limited by the friction ellipse
-// (Fx/(D Fz))^2 + (Fy/(D Fz))^2 <= 1. The lateral force has priority:
-//   |Fx| <= sqrt((D Fz)^2 - Fy^2)
-// because the lateral curve is the FSSIM reference (kept unchanged it keeps the
-// lateral dynamics and the tyre oracle identical), and because the longitudinal force
-// here is an actuator demand with no slip model: clipping it is what the car's traction
-// control and ABS do, whereas clipping Fy would make a full-brake demand steal the
-// cornering force, which an ABS prevents.
+// Powertrain: the throttle asks its share of the motor torque limit of each
+// driven wheel (drive_split_front, equal left/right) plus the torque-vectoring
+// shift +-M r / track; each wheel's torque fades at the motor speed limit, the
+// brake demand goes first to regeneration (if any), and the sum of the wheel
+// powers is capped by the motor and accumulator limits. Electrical power =
+// mechanical / eta driving, mechanical x eta regenerating.
 
 namespace {
 
-// the integrated state: rigid body, actuators, load transfer
 struct X {
-  double px, py, yaw, vx, vy, r, steer, thr, brk, ax_load;
+  double px, py, yaw, vx, vy, r, steer, thr, brk, ax_load, energy;
+  std::array<double, 4> w, ux, uy;
 };
 
 inline X axpy(const X& s, double h, const X& k) {
-  return {s.px + h * k.px,       s.py + h * k.py,         s.yaw + h * k.yaw, s.vx + h * k.vx,
-          s.vy + h * k.vy,       s.r + h * k.r,           s.steer + h * k.steer,
-          s.thr + h * k.thr,     s.brk + h * k.brk,       s.ax_load + h * k.ax_load};
+  X o{s.px + h * k.px,       s.py + h * k.py,       s.yaw + h * k.yaw, s.vx + h * k.vx,   s.vy + h * k.vy,
+      s.r + h * k.r,         s.steer + h * k.steer, s.thr + h * k.thr, s.brk + h * k.brk, s.ax_load + h * k.ax_load,
+      s.energy + h * k.energy, {}, {}, {}};
+  for (std::size_t i = 0; i < 4; ++i) {
+    o.w[i] = s.w[i] + h * k.w[i];
+    o.ux[i] = s.ux[i] + h * k.ux[i];
+    o.uy[i] = s.uy[i] + h * k.uy[i];
+  }
+  return o;
 }
 
-// a state derivative, plus the CG acceleration in the body frame it implies
+// a state derivative, plus what it implies
 struct Deriv {
   X d;
-  double ax;  // m/s^2, vx' - r vy
-  double ay;  // m/s^2, vy' + r vx
+  double ax;     // m/s^2, vx' - r vy
+  double ay;     // m/s^2, vy' + r vx
+  double power;  // W, electrical
+  std::array<double, 4> t_net;   // N m, drive torque - Fx r: what turns the wheel apart from friction
+  std::array<double, 4> t_fric;  // N m, the friction torque available (brake + rolling resistance)
 };
-
-// kinematic tracking time constant, s: how fast vy and r settle on their kinematic
-// values when the car enters the kinematic regime with a residual slip. Its rate
-// 1/tau_kin = 100 1/s gives |z| = dt / tau_kin = 0.1 at 1 kHz, far inside the RK4
-// stability interval (|z| < 2.785), and is fast compared with the vehicle motion.
-constexpr double kKinematicTimeConstant = 0.01;
-
-// smallest regularisation speed of the standstill forces, m/s (see standstill_speed)
-constexpr double kMinStandstillSpeed = 0.02;
 
 // everything constant over one step
 struct Model {
   const VehicleParams* p;
-  double inv_m, inv_iz, wheelbase, inv_l;
-  double fz_front_static, fz_rear_static;  // N
-  double load_transfer_gain;               // N per m/s^2: m h_cg / L
-  double inv_v_reg;                        // 1 / (m/s): standstill regularisation
+  double inv_m, inv_iz;
+  double transfer_per_wheel;  // N per m/s^2: m h_cg / L / 2
+  std::array<double, 4> x, y;  // contact points from the CG, m
+  std::array<double, 4> fz_static, aero_share, inv_fz_static;
+  std::array<double, 4> inv_inertia;
+  std::array<double, 4> drive_share;  // of the wheel torque limit
+  std::array<double, 4> brake_torque;  // N m at full brake
+  std::array<double, 4> regen_torque;  // N m available at the wheel
+  std::array<double, 4> c_x, c_y;      // N s/m, low-speed damping at the static load
+  std::array<double, 4> tv_torque;     // N m, torque vectoring shift
+  std::array<double, 4> traction;      // traction control's torque factor, held over the step
+  std::array<double, 4> friction_sign;  // 0: held at rest; +-1: friction opposes that spin
+  double rr_torque;                     // N m per wheel
+  double radius;
+  double t_wheel_max, p_wheel_max, w_max, inv_fade;
+  double eta, inv_eta, inv_sigma_x, inv_sigma_y;
   double inv_tau_steer, inv_tau_thr, inv_tau_brk, inv_tau_pitch;  // 1/s, 0 = instantaneous (set outside RK4)
-  // commands after dead time and limits
   double steer_cmd, thr_cmd, brk_cmd;
 };
-
-// standstill regularisation: sat(vx) = clamp(vx / v_reg, -1, 1) replaces sign(vx) in
-// the rolling resistance and the brakes, so that at vx = 0 they are exactly zero (no
-// creeping, the car at rest stays at rest) and near vx = 0 they are a linear damper.
-// Stiffness limit: inside |vx| < v_reg they act as m vx' = -c vx with
-// c = (F_brake_max + Cr0) / v_reg, eigenvalue lambda = -c / m. RK4's amplification
-// R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24, z = lambda dt, is stable for z > -2.785
-// and stays in (0, 1) there, so vx decays monotonically and never changes sign (no
-// rolling backwards under braking). Above v_reg the deceleration is at most
-// a_max = (F_brake_max + Cr0 + F_drag) / m, and one step cannot jump over the band
-// [0, v_reg] if a_max dt <= v_reg. Both hold with margin for
-//   v_reg = 2 (F_brake_max + Cr0) dt / m   (z = -0.5, and drag up to F_brake_max + Cr0),
-// floored at 2 cm/s; with the default car at 1 kHz, v_reg = 3.9 cm/s.
-double standstill_speed_impl(const VehicleParams& p, double dt) {
-  return std::max(kMinStandstillSpeed, 2.0 * (p.brake_force_max + p.cr0) * dt / p.mass);
-}
 
 // first-order lag rate, 0 (= instantaneous, applied outside RK4) when tau < dt/2:
 // such a lag is not resolvable at this step and explicit RK4 would go unstable for
 // dt / tau > 2.785
 inline double lag_rate(double tau, double dt) { return tau < 0.5 * dt ? 0.0 : 1.0 / tau; }
 
-// the state derivative
+// the motors' torque at each wheel (N m) and the regeneration that replaces
+// friction braking, under the motor and power limits; returns the electrical power (W)
+double motor_torques(const Model& m, const X& s, std::array<double, 4>& torque, std::array<double, 4>& regen) {
+  const double request = s.thr * m.t_wheel_max;
+  double p_drive = 0.0, p_regen = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    regen[i] = 0.0;
+    torque[i] = 0.0;
+    if (m.drive_share[i] == 0.0) continue;
+    const double w = s.w[i];
+    const double limit = m.drive_share[i] * m.t_wheel_max * std::clamp((m.w_max - std::abs(w)) * m.inv_fade, 0.0, 1.0);
+    double t = m.drive_share[i] * request * m.traction[i] + m.tv_torque[i];
+    if (m.regen_torque[i] > 0.0 && s.brk > 0.0) {
+      const double fade = std::clamp((std::abs(w) * m.radius - kRegenOff) * (1.0 / (kRegenFull - kRegenOff)), 0.0, 1.0);
+      regen[i] = std::min(m.regen_torque[i] * fade, s.brk * m.brake_torque[i]);
+      t -= regen[i] * sign(w);
+    }
+    torque[i] = std::clamp(t, -limit, limit);
+    const double pw = torque[i] * w;
+    (pw > 0.0 ? p_drive : p_regen) += pw;
+  }
+  const double k_drive = p_drive > m.p_wheel_max ? m.p_wheel_max / p_drive : 1.0;
+  const double k_regen = -p_regen > m.p_wheel_max ? m.p_wheel_max / -p_regen : 1.0;
+  if (k_drive < 1.0 || k_regen < 1.0) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      const double k = torque[i] * s.w[i] > 0.0 ? k_drive : k_regen;
+      torque[i] *= k;
+      regen[i] *= k_regen;
+    }
+  }
+  return p_drive * k_drive * m.inv_eta + p_regen * k_regen * m.eta;
+}
+
+// the state derivative (the wheels' spin with the friction decided in step())
 Deriv derivative(const Model& m, const X& s) {
   const VehicleParams& p = *m.p;
   Deriv out{};
@@ -170,75 +249,67 @@ Deriv derivative(const Model& m, const X& s) {
   d.thr = (m.thr_cmd - s.thr) * m.inv_tau_thr;
   d.brk = (m.brk_cmd - s.brk) * m.inv_tau_brk;
 
-  // aero: downforce and drag grow with vx^2
-  const double vx2 = s.vx * s.vx;
-  const double f_down = p.c_down * vx2;
+  // aero: downforce and drag grow with vx^2; the lagged load transfer per wheel
+  const double f_down = p.c_down * s.vx * s.vx;
   const double f_drag = p.c_drag * s.vx * std::abs(s.vx);
+  const double transfer = m.transfer_per_wheel * s.ax_load;
 
-  // normal loads: static + aero + lagged longitudinal load transfer
-  const double transfer = m.load_transfer_gain * s.ax_load;
-  const double fz_f = std::max(0.0, m.fz_front_static + p.aero_balance_front * f_down - transfer);
-  const double fz_r = std::max(0.0, m.fz_rear_static + (1.0 - p.aero_balance_front) * f_down + transfer);
-
-  // standstill regularisation of the forces that oppose motion
-  const double sat = std::clamp(s.vx * m.inv_v_reg, -1.0, 1.0);
-
-  // longitudinal demand per axle (wheel frame): motor minus brake
-  const double f_motor = s.thr * p.cm1;
-  const double f_brake = s.brk * p.brake_force_max * sat;
-  const double fx_f_demand = p.drive_split_front * f_motor - p.brake_split_front * f_brake;
-  const double fx_r_demand = (1.0 - p.drive_split_front) * f_motor - (1.0 - p.brake_split_front) * f_brake;
-  const double f_res = -f_drag - p.cr0 * sat;
-
-  // blend weight of the dynamic model
-  const double v = std::sqrt(vx2 + s.vy * s.vy);
-  const double lambda = dynamic_weight(v);
-
-  // lateral tyre forces, only where the dynamic model has weight (no slip angle at rest)
-  double fy_f = 0.0, fy_r = 0.0;
-  if (lambda > 0.0) {
-    const double alpha_f = slip_angle(s.vx, s.vy + p.lf * s.r, s.steer);
-    const double alpha_r = slip_angle(s.vx, s.vy - p.lr * s.r, 0.0);
-    fy_f = -tyre_mu(p, alpha_f) * fz_f;
-    fy_r = -tyre_mu(p, alpha_r) * fz_r;
-  }
-
-  // friction ellipse per axle, lateral first: |Fx| <= sqrt((D Fz)^2 - Fy^2)
-  const double fmax_f = p.tyre_d * fz_f;
-  const double fmax_r = p.tyre_d * fz_r;
-  const double fx_lim_f = fy_f == 0.0 ? fmax_f : std::sqrt(std::max(0.0, fmax_f * fmax_f - fy_f * fy_f));
-  const double fx_lim_r = fy_r == 0.0 ? fmax_r : std::sqrt(std::max(0.0, fmax_r * fmax_r - fy_r * fy_r));
-  const double fx_f = std::clamp(fx_f_demand, -fx_lim_f, fx_lim_f);
-  const double fx_r = std::clamp(fx_r_demand, -fx_lim_r, fx_lim_r);
+  std::array<double, 4> t_drive, regen;
+  out.power = motor_torques(m, s, t_drive, regen);
+  d.energy = out.power;
 
   const double sd = std::sin(s.steer);
   const double cd = std::cos(s.steer);
+  double fx_sum = 0.0, fy_sum = 0.0, mz = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const bool front = i < 2;
+    const double c = front ? cd : 1.0;
+    const double sn = front ? sd : 0.0;
+    // the contact point's velocity, body frame then wheel frame; sideways,
+    // the axle centre's (the single-track model: in effect Ackermann steering,
+    // the two wheels of an axle share its slip angle)
+    const double vbx = s.vx - s.r * m.y[i];
+    const double vby = s.vy + s.r * m.x[i];
+    const double vcx = c * vbx + sn * vby;
+    const double vcy = c * vby - sn * s.vx;
+    const double fz = std::max(0.0, m.fz_static[i] + m.aero_share[i] * f_down + (front ? -transfer : transfer));
+    TyreForce f = tyre_force(p, s.ux[i] * m.inv_sigma_x, std::atan(s.uy[i] * m.inv_sigma_y), fz);
+    const double v_slip = s.w[i] * m.radius - vcx;
+    const double low = 1.0 - std::abs(vcx) * (1.0 / kLowSpeed);
+    if (low > 0.0) {
+      // the damper adds to the spring up to the friction the wheel has: it
+      // still opposes the slip (dissipates), never beyond what the road takes
+      const double k = low * std::min(1.0, fz * m.inv_fz_static[i]);
+      const double mu = load_factor(p, fz) * fz;
+      f.fx = std::clamp(f.fx + k * m.c_x[i] * v_slip, -p.tyre_dx * mu, p.tyre_dx * mu);
+      f.fy = std::clamp(f.fy - k * m.c_y[i] * vcy, -p.tyre_d * mu, p.tyre_d * mu);
+    }
+    // the deflections relax towards the slips
+    d.ux[i] = v_slip - std::abs(vcx) * s.ux[i] * m.inv_sigma_x;
+    d.uy[i] = vcy - std::abs(vcx) * s.uy[i] * m.inv_sigma_y;
+    // the wheel's spin
+    out.t_net[i] = t_drive[i] - f.fx * m.radius;
+    out.t_fric[i] = s.brk * m.brake_torque[i] - regen[i] + m.rr_torque;
+    d.w[i] = m.friction_sign[i] == 0.0 ? 0.0
+                                       : (out.t_net[i] - m.friction_sign[i] * out.t_fric[i]) * m.inv_inertia[i];
+    // the force on the chassis, body frame: the longitudinal part at the
+    // contact point, the lateral part at the axle centre (where its slip was
+    // taken, so that each part's power is the force times its slip velocity
+    // and the energy argument above holds)
+    const double fbx = c * f.fx - sn * f.fy;
+    const double fby = sn * f.fx + c * f.fy;
+    fx_sum += fbx;
+    fy_sum += fby;
+    mz += m.x[i] * fby - m.y[i] * c * f.fx;
+  }
 
-  // kinematic and dynamic velocity derivatives, blended
-  double vx_dot = 0.0, vy_dot = 0.0, r_dot = 0.0;
-  if (lambda < 1.0) {
-    const double vx_dot_k = (fx_f + fx_r + f_res) * m.inv_m;
-    const double td = sd / cd;
-    const double r_kin = s.vx * td * m.inv_l;
-    const double r_kin_dot = (vx_dot_k * td + s.vx * d.steer / (cd * cd)) * m.inv_l;
-    const double w = 1.0 - lambda;
-    vx_dot += w * vx_dot_k;
-    r_dot += w * (r_kin_dot + (r_kin - s.r) * (1.0 / kKinematicTimeConstant));
-    vy_dot += w * (p.lr * r_kin_dot + (p.lr * r_kin - s.vy) * (1.0 / kKinematicTimeConstant));
-  }
-  if (lambda > 0.0) {
-    const double fy_f_body = fx_f * sd + fy_f * cd;  // front axle force along body y
-    vx_dot += lambda * (s.r * s.vy + (fx_f * cd - fy_f * sd + fx_r + f_res) * m.inv_m);
-    vy_dot += lambda * (-s.r * s.vx + (fy_f_body + fy_r) * m.inv_m);
-    r_dot += lambda * ((p.lf * fy_f_body - p.lr * fy_r) * m.inv_iz);
-  }
-  d.vx = vx_dot;
-  d.vy = vy_dot;
-  d.r = r_dot;
+  d.vx = s.r * s.vy + (fx_sum - f_drag) * m.inv_m;
+  d.vy = -s.r * s.vx + fy_sum * m.inv_m;
+  d.r = mz * m.inv_iz;
 
   // the CG acceleration in the body frame, and the suspension's lagged copy of ax
-  out.ax = vx_dot - s.r * s.vy;
-  out.ay = vy_dot + s.r * s.vx;
+  out.ax = d.vx - s.r * s.vy;
+  out.ay = d.vy + s.r * s.vx;
   d.ax_load = (out.ax - s.ax_load) * m.inv_tau_pitch;
 
   // pose: rotate the body velocity into the map
@@ -254,25 +325,69 @@ Deriv derivative(const Model& m, const X& s) {
 // controller must not poison the state)
 inline double finite_or(double v, double fallback) { return std::isfinite(v) ? v : fallback; }
 
+// contact points from the CG: FL, FR, RL, RR
+std::array<Vec2, 4> wheel_offsets_cg(const VehicleParams& p) {
+  return {Vec2{p.lf, 0.5 * p.track_front}, Vec2{p.lf, -0.5 * p.track_front}, Vec2{-p.lr, 0.5 * p.track_rear},
+          Vec2{-p.lr, -0.5 * p.track_rear}};
+}
+
+// static wheel load (N) and the tyre's slip and cornering stiffness there
+struct WheelStatics {
+  double fz;        // N
+  double c_kappa;   // N per unit slip ratio
+  double c_alpha;   // N/rad
+};
+WheelStatics wheel_statics(const VehicleParams& p, std::size_t i) {
+  const double axle = i < 2 ? p.lr : p.lf;
+  WheelStatics w;
+  w.fz = 0.5 * p.mass * kGravity * axle / (p.lf + p.lr);
+  const double scale = p.tyre_c * load_factor(p, w.fz) * w.fz;
+  w.c_kappa = p.tyre_bx * p.tyre_dx * scale;
+  w.c_alpha = p.tyre_b * p.tyre_d * scale;
+  return w;
+}
+
+
+// the low-speed damper: kLowSpeedDamping of critical for a quarter of the car on
+// a spring of stiffness c / sigma
+double low_speed_damping(const VehicleParams& p, double stiffness, double sigma) {
+  return kLowSpeedDamping * 2.0 * std::sqrt(stiffness / sigma * 0.25 * p.mass);
+}
+
 }  // namespace
 
-double standstill_speed(const VehicleParams& p, double dt) { return standstill_speed_impl(p, dt); }
-
 double stable_step_limit(const VehicleParams& p) {
-  const double v = 1.5;  // m/s, where dynamic_weight starts to rise
-  const double wheelbase = p.lf + p.lr;
-  const double fz_front = p.mass * kGravity * p.lr / wheelbase;
-  const double fz_rear = p.mass * kGravity * p.lf / wheelbase;
-  const double bcd = p.tyre_b * p.tyre_c * p.tyre_d;
-  const double c_front = bcd * fz_front, c_rear = bcd * fz_rear;
-  const double lateral = (c_front + c_rear) / (p.mass * v);
-  const double yaw = (c_front * p.lf * p.lf + c_rear * p.lr * p.lr) / (p.inertia_z * v);
-  return 2.5 / std::max(lateral, yaw);
+  const double r = p.wheel_radius;
+  const double v_top = std::max(top_speed(p), 1.0);
+  const std::array<Vec2, 4> off = wheel_offsets_cg(p);
+  double lambda = v_top / std::min(p.relaxation_length_x, p.relaxation_length_y);  // relaxation at top speed
+  double k_lat = 0.0, k_yaw = 0.0, c_lat = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    const WheelStatics w = wheel_statics(p, i);
+    const double inertia = wheel_inertia_of(p, i);
+    // the wheel's spin on the tyre's longitudinal spring, at twice the static
+    // load plus the downforce at top speed
+    const double share = i < 2 ? p.aero_balance_front : 1.0 - p.aero_balance_front;
+    const double fz_max = 2.0 * w.fz + 0.5 * share * p.c_down * v_top * v_top;
+    const double c_kappa_max = p.tyre_bx * p.tyre_c * p.tyre_dx * load_factor(p, fz_max) * fz_max;
+    lambda = std::max(lambda, std::sqrt(c_kappa_max * r * r / (inertia * p.relaxation_length_x)));
+    lambda = std::max(lambda, low_speed_damping(p, w.c_kappa, p.relaxation_length_x) * r * r / inertia);
+    const double k = w.c_alpha / p.relaxation_length_y;
+    k_lat += k;
+    k_yaw += k * off[i].x * off[i].x;
+    c_lat += low_speed_damping(p, w.c_alpha, p.relaxation_length_y);
+  }
+  // the chassis on the lateral tyre springs: sideways, in yaw, and their damping
+  lambda = std::max({lambda, std::sqrt(k_lat / p.mass), std::sqrt(k_yaw / p.inertia_z), c_lat / p.mass});
+  return 2.5 / lambda;
 }
 
 bool is_finite(const VehicleState& s) {
-  for (const double v : {s.x, s.y, s.yaw, s.vx, s.vy, s.r, s.steering, s.throttle, s.brake, s.ax_load, s.ax, s.ay, s.yaw_accel})
+  for (const double v : {s.x, s.y, s.yaw, s.vx, s.vy, s.r, s.steering, s.throttle, s.brake, s.ax_load, s.ax, s.ay,
+                         s.yaw_accel, s.energy, s.power})
     if (!std::isfinite(v)) return false;
+  for (std::size_t i = 0; i < 4; ++i)
+    if (!std::isfinite(s.omega[i]) || !std::isfinite(s.u_x[i]) || !std::isfinite(s.u_y[i])) return false;
   return true;
 }
 
@@ -289,40 +404,62 @@ VehicleState initial_state(const VehicleParams& p, Pose2 base_pose_in) {
 VehicleState rolling_state(const VehicleParams& p, Pose2 base_pose_in, double speed) {
   VehicleState s = initial_state(p, base_pose_in);
   s.vx = speed;
+  s.omega.fill(speed / p.wheel_radius);
   return s;
 }
 
-void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
-  assert(dt > 0.0);
+namespace {
 
-  // commands: non-finite ones replaced by safe values, then limited
-  const double steer_req = std::clamp(finite_or(in.steering_angle, s.steering), -p.steering_max, p.steering_max);
-  const double thr_cmd = std::clamp(finite_or(in.throttle, 0.0), 0.0, 1.0);
-  const double brk_cmd = std::clamp(finite_or(in.brake, 1.0), 0.0, 1.0);
-
-  // steering dead time: a ring buffer of the last n commands; n rounded to whole steps
-  double steer_cmd = steer_req;
-  if (p.steering_dead_time > 0.0) {
-    constexpr std::size_t cap = kMaxDelaySteps + 1;
-    auto n = static_cast<std::size_t>(std::lround(p.steering_dead_time / dt));
-    assert(n <= kMaxDelaySteps && "steering_dead_time / dt exceeds the delay line");
-    n = std::min(n, kMaxDelaySteps);
-    s.steering_delay[s.delay_head] = steer_req;
-    steer_cmd = s.steering_delay[(s.delay_head + cap - n) % cap];
-    s.delay_head = (s.delay_head + 1) % cap;
-  }
-
-  // the model for this step
+// the model of one step: the car's constants, the commands, and what the VCU
+// (traction control, torque vectoring) decided from the state at its start
+Model make_model(const VehicleParams& p, const VehicleState& s, const DriverInput& in, double steer_cmd, double dt) {
   Model m;
   m.p = &p;
   m.inv_m = 1.0 / p.mass;
   m.inv_iz = 1.0 / p.inertia_z;
-  m.wheelbase = p.lf + p.lr;
-  m.inv_l = 1.0 / m.wheelbase;
-  m.fz_front_static = p.mass * kGravity * p.lr * m.inv_l;
-  m.fz_rear_static = p.mass * kGravity * p.lf * m.inv_l;
-  m.load_transfer_gain = p.mass * p.h_cg * m.inv_l;
-  m.inv_v_reg = 1.0 / standstill_speed_impl(p, dt);
+  m.transfer_per_wheel = 0.5 * p.mass * p.h_cg / (p.lf + p.lr);
+  m.radius = p.wheel_radius;
+  m.rr_torque = 0.25 * p.cr0 * p.wheel_radius;
+  m.t_wheel_max = p.motor_torque_max * p.gear_ratio;
+  m.p_wheel_max = drive_power_limit(p);
+  m.w_max = p.motor_speed_max / p.gear_ratio;
+  m.inv_fade = 1.0 / (kMotorFade * m.w_max);
+  m.eta = p.drivetrain_efficiency;
+  m.inv_eta = 1.0 / p.drivetrain_efficiency;
+  m.inv_sigma_x = 1.0 / p.relaxation_length_x;
+  m.inv_sigma_y = 1.0 / p.relaxation_length_y;
+  const std::array<Vec2, 4> off = wheel_offsets_cg(p);
+  const double yaw_moment = finite_or(in.yaw_moment, 0.0);
+  const double sd = std::sin(s.steering), cd = std::cos(s.steering);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const bool front = i < 2;
+    const WheelStatics w = wheel_statics(p, i);
+    m.x[i] = off[i].x;
+    m.y[i] = off[i].y;
+    m.fz_static[i] = w.fz;
+    m.inv_fz_static[i] = 1.0 / w.fz;
+    m.aero_share[i] = 0.5 * (front ? p.aero_balance_front : 1.0 - p.aero_balance_front);
+    m.inv_inertia[i] = 1.0 / wheel_inertia_of(p, i);
+    m.drive_share[i] = drive_share(p, i);
+    m.brake_torque[i] = 0.5 * (front ? p.brake_split_front : 1.0 - p.brake_split_front) * p.brake_force_max * p.wheel_radius;
+    m.regen_torque[i] = m.drive_share[i] * p.regen_torque_max * p.gear_ratio;
+    m.c_x[i] = low_speed_damping(p, w.c_kappa, p.relaxation_length_x);
+    m.c_y[i] = low_speed_damping(p, w.c_alpha, p.relaxation_length_y);
+    // torque vectoring: the driven axles share the yaw moment as their drive
+    // shares, each as a left/right force difference M / track: +-M r / track
+    const double track = front ? p.track_front : p.track_rear;
+    m.tv_torque[i] = (off[i].y > 0.0 ? -1.0 : 1.0) * 2.0 * m.drive_share[i] * yaw_moment * p.wheel_radius / track;
+    // traction control: each driven wheel's torque is cut linearly from the
+    // slip ratio kappa* to (1 + kTractionBand) kappa*, sampled at the step's start
+    m.traction[i] = 1.0;
+    if (p.traction_control_slip > 0.0 && m.drive_share[i] > 0.0) {
+      const double vbx = s.vx - s.r * off[i].y, vby = s.vy + s.r * off[i].x;
+      const double vcx = front ? cd * vbx + sd * vby : vbx;
+      const double kappa = (s.omega[i] * p.wheel_radius - vcx) / std::max(std::abs(vcx), kTractionSpeedFloor);
+      const double excess = (kappa - p.traction_control_slip) / (kTractionBand * p.traction_control_slip);
+      m.traction[i] = std::clamp(1.0 - excess, 0.0, 1.0);
+    }
+  }
   m.inv_tau_steer = lag_rate(p.steering_time_constant, dt);
   m.inv_tau_thr = lag_rate(p.throttle_time_constant, dt);
   m.inv_tau_brk = lag_rate(p.brake_time_constant, dt);
@@ -330,8 +467,50 @@ void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double
   // shorter than dt/2 it is stretched to dt/2 (|z| = 2 < 2.785, still stable)
   m.inv_tau_pitch = 1.0 / std::max(p.pitch_time_constant, 0.5 * dt);
   m.steer_cmd = steer_cmd;
-  m.thr_cmd = thr_cmd;
-  m.brk_cmd = brk_cmd;
+  m.thr_cmd = std::clamp(finite_or(in.throttle, 0.0), 0.0, 1.0);
+  m.brk_cmd = std::clamp(finite_or(in.brake, 1.0), 0.0, 1.0);
+  return m;
+}
+
+// the steering command after the dead time: a ring buffer of the last n
+// requests; n rounded to whole steps
+double delayed_steering(const VehicleParams& p, VehicleState& s, double steer_req, double dt) {
+  if (p.steering_dead_time <= 0.0) return steer_req;
+  constexpr std::size_t cap = kMaxDelaySteps + 1;
+  auto n = static_cast<std::size_t>(std::lround(p.steering_dead_time / dt));
+  assert(n <= kMaxDelaySteps && "steering_dead_time / dt exceeds the delay line");
+  n = std::min(n, kMaxDelaySteps);
+  s.steering_delay[s.delay_head] = steer_req;
+  const double out = s.steering_delay[(s.delay_head + cap - n) % cap];
+  s.delay_head = (s.delay_head + 1) % cap;
+  return out;
+}
+
+// the friction torques of each wheel for this step (static friction, decided
+// at its start from the first RK4 stage): a wheel at rest stays held while the
+// torques that turn it are within the friction available; otherwise the
+// friction opposes its spin (or, from rest, the torque that breaks it away)
+void decide_friction(Model& m, const X& x0, Deriv& k1) {
+  for (std::size_t i = 0; i < 4; ++i) {
+    double sgn = sign(x0.w[i]);
+    if (sgn == 0.0) sgn = std::abs(k1.t_net[i]) <= k1.t_fric[i] ? 0.0 : sign(k1.t_net[i]);
+    m.friction_sign[i] = sgn;
+    k1.d.w[i] = sgn == 0.0 ? 0.0 : (k1.t_net[i] - sgn * k1.t_fric[i]) * m.inv_inertia[i];
+  }
+}
+
+}  // namespace
+
+void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
+  assert(dt > 0.0);
+
+  // commands: non-finite ones replaced by safe values, then limited
+  const double steer_req = std::clamp(finite_or(in.steering_angle, s.steering), -p.steering_max, p.steering_max);
+  const double steer_cmd = delayed_steering(p, s, steer_req, dt);
+  Model m = make_model(p, s, in, steer_cmd, dt);
+  if (m.brk_cmd >= kPlausibilityBrake && m.thr_cmd > kPlausibilityCut) s.torque_cut = true;
+  if (m.thr_cmd < kPlausibilityReset) s.torque_cut = false;
+  if (s.torque_cut) m.thr_cmd = 0.0;
 
   // instantaneous actuators jump to the command at the start of the step
   // (steering still rate limited), and are held over the step
@@ -339,27 +518,24 @@ void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double
     const double max_move = p.steering_rate_max * dt;
     s.steering += std::clamp(steer_cmd - s.steering, -max_move, max_move);
   }
-  if (m.inv_tau_thr == 0.0) s.throttle = thr_cmd;
-  if (m.inv_tau_brk == 0.0) s.brake = brk_cmd;
+  if (m.inv_tau_thr == 0.0) s.throttle = m.thr_cmd;
+  if (m.inv_tau_brk == 0.0) s.brake = m.brk_cmd;
 
-  // classic RK4
-  const X x0{s.x, s.y, s.yaw, s.vx, s.vy, s.r, s.steering, s.throttle, s.brake, s.ax_load};
+  // a wheel turning slower than kRestSpin is at rest
+  for (double& w : s.omega)
+    if (std::abs(w) < kRestSpin) w = 0.0;
+
+  // classic RK4, the wheels' friction decided at the first stage
+  const X x0{s.x, s.y, s.yaw, s.vx, s.vy, s.r, s.steering, s.throttle, s.brake, s.ax_load, s.energy, s.omega, s.u_x, s.u_y};
   const double h = 0.5 * dt;
-  const Deriv k1 = derivative(m, x0);
+  m.friction_sign.fill(1.0);
+  Deriv k1 = derivative(m, x0);
+  decide_friction(m, x0, k1);
   const Deriv k2 = derivative(m, axpy(x0, h, k1.d));
   const Deriv k3 = derivative(m, axpy(x0, h, k2.d));
   const Deriv k4 = derivative(m, axpy(x0, dt, k3.d));
-  X k;
-  k.px = k1.d.px + 2.0 * (k2.d.px + k3.d.px) + k4.d.px;
-  k.py = k1.d.py + 2.0 * (k2.d.py + k3.d.py) + k4.d.py;
-  k.yaw = k1.d.yaw + 2.0 * (k2.d.yaw + k3.d.yaw) + k4.d.yaw;
-  k.vx = k1.d.vx + 2.0 * (k2.d.vx + k3.d.vx) + k4.d.vx;
-  k.vy = k1.d.vy + 2.0 * (k2.d.vy + k3.d.vy) + k4.d.vy;
-  k.r = k1.d.r + 2.0 * (k2.d.r + k3.d.r) + k4.d.r;
-  k.steer = k1.d.steer + 2.0 * (k2.d.steer + k3.d.steer) + k4.d.steer;
-  k.thr = k1.d.thr + 2.0 * (k2.d.thr + k3.d.thr) + k4.d.thr;
-  k.brk = k1.d.brk + 2.0 * (k2.d.brk + k3.d.brk) + k4.d.brk;
-  k.ax_load = k1.d.ax_load + 2.0 * (k2.d.ax_load + k3.d.ax_load) + k4.d.ax_load;
+  X k = axpy(axpy(k1.d, 2.0, k2.d), 2.0, k3.d);
+  k = axpy(k, 1.0, k4.d);
   const X x1 = axpy(x0, dt / 6.0, k);
 
   s.x = x1.px;
@@ -375,11 +551,22 @@ void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double
   s.throttle = std::clamp(x1.thr, 0.0, 1.0);
   s.brake = std::clamp(x1.brk, 0.0, 1.0);
   s.ax_load = x1.ax_load;
+  s.energy = x1.energy;
+  // friction stops a wheel, never turns it back; a sliding tyre's deflection
+  // stops growing at kSlipCap
+  const double ux_cap = kSlipCap / p.tyre_bx * p.relaxation_length_x;
+  const double uy_cap = std::tan(std::min(kSlipCap / p.tyre_b, 1.4)) * p.relaxation_length_y;
+  for (std::size_t i = 0; i < 4; ++i) {
+    s.omega[i] = x1.w[i] * m.friction_sign[i] < 0.0 ? 0.0 : x1.w[i];
+    s.u_x[i] = std::clamp(x1.ux[i], -ux_cap, ux_cap);
+    s.u_y[i] = std::clamp(x1.uy[i], -uy_cap, uy_cap);
+  }
 
-  // mean accelerations over the step, with RK4's weights
+  // mean accelerations and power over the step, with RK4's weights
   s.ax = (k1.ax + 2.0 * (k2.ax + k3.ax) + k4.ax) / 6.0;
   s.ay = (k1.ay + 2.0 * (k2.ay + k3.ay) + k4.ay) / 6.0;
   s.yaw_accel = k.r / 6.0;
+  s.power = (k1.power + 2.0 * (k2.power + k3.power) + k4.power) / 6.0;
 }
 
 // ---------------------------------------------------------------------------
@@ -398,13 +585,6 @@ Vec2 body_acceleration(const VehicleState& s) { return {s.ax, s.ay}; }
 
 double speed(const VehicleState& s) { return std::sqrt(s.vx * s.vx + s.vy * s.vy); }
 
-namespace {
-// contact patches in the body frame relative to the CG: FL, FR, RL, RR
-std::array<Vec2, 4> wheel_offsets_cg(const VehicleParams& p) {
-  return {Vec2{p.lf, 0.5 * p.track_front}, Vec2{p.lf, -0.5 * p.track_front}, Vec2{-p.lr, 0.5 * p.track_rear},
-          Vec2{-p.lr, -0.5 * p.track_rear}};
-}
-}  // namespace
 
 std::array<Vec2, 4> wheel_positions(const VehicleParams& p, const VehicleState& s) {
   const Pose2 cg{s.x, s.y, s.yaw};
@@ -414,15 +594,17 @@ std::array<Vec2, 4> wheel_positions(const VehicleParams& p, const VehicleState& 
   return out;
 }
 
-std::array<double, 4> wheel_speeds(const VehicleParams& p, const VehicleState& s) {
+std::array<double, 4> wheel_speeds(const VehicleParams&, const VehicleState& s) { return s.omega; }
+
+std::array<double, 4> slip_ratios(const VehicleParams& p, const VehicleState& s) {
   const std::array<Vec2, 4> off = wheel_offsets_cg(p);
   const Vec2 front_heading{std::cos(s.steering), std::sin(s.steering)};
   std::array<double, 4> out;
   for (std::size_t i = 0; i < 4; ++i) {
-    // velocity of the contact point: v_cg + r x offset
+    // velocity of the contact point: v_cg + r x offset, along the wheel
     const Vec2 v{s.vx - s.r * off[i].y, s.vy + s.r * off[i].x};
-    const Vec2 heading = i < 2 ? front_heading : Vec2{1.0, 0.0};
-    out[i] = dot(v, heading) / p.wheel_radius;
+    const double along = dot(v, i < 2 ? front_heading : Vec2{1.0, 0.0});
+    out[i] = (s.omega[i] * p.wheel_radius - along) / std::max(std::abs(along), 1.0);
   }
   return out;
 }

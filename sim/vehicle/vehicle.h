@@ -1,8 +1,15 @@
 #pragma once
-// the vehicle model: a dynamic single-track (bicycle) model with Pacejka lateral
-// tyres, a friction ellipse per axle, aero, a low-speed blend to the kinematic
-// model (as in AMZ FSSIM), and lagged, rate-limited actuators with an optional
-// steering dead time.
+// the vehicle model: a dynamic single-track (bicycle) model of the chassis on
+// four rotating wheels. Each wheel has its own spin, longitudinal slip and
+// slip angle, carried as tyre deflections with relaxation lengths (so the model
+// holds from standstill to top speed without a kinematic blend), and a
+// combined-slip Pacejka tyre with load sensitivity. An electric powertrain per
+// the FS rules (motor torque and power envelope, gear, efficiency, the
+// accumulator's power limit, optional regeneration, a torque split and torque
+// vectoring, traction control in the car's VCU) drives the wheels; brakes and
+// rolling resistance act on them as friction torques that stick at rest. Aero
+// load, lagged longitudinal load transfer, and lagged, rate-limited actuators
+// with an optional steering dead time complete it.
 //
 // MuJoCo style: a constant model (VehicleParams) + mutable state (VehicleState)
 // + a free function step(). Many vehicles can be simulated side by side; nothing
@@ -24,8 +31,8 @@ inline constexpr std::size_t kMaxDelaySteps = 255;
 inline constexpr double kMaxSteeringDeadTime = 0.25;
 
 // every physical parameter of the car. No defaults in code: each field starts as
-// NaN and gets its value from scenarios/vehicles/default.ini (keys = field names);
-// params::validate() rejects a field left unset (NaN is outside every bound).
+// NaN and gets its value from a car file (scenarios/vehicles/*.ini, keys = field
+// names); params::validate() rejects a field left unset (NaN is outside every bound).
 struct VehicleParams {
   // mass and geometry
   double mass = kUnset;
@@ -36,21 +43,38 @@ struct VehicleParams {
   double track_front = kUnset;
   double track_rear = kUnset;
   double wheel_radius = kUnset;
-  // tyre: Pacejka magic formula, lateral, mu_y(a) = D sin(C atan(B a - E (B a - atan(B a))))
+  // rotating parts
+  double wheel_inertia = kUnset;
+  double driveline_inertia = kUnset;
+  // tyre: Pacejka magic formula on the combined slip (see tyre_force)
   double tyre_b = kUnset;
   double tyre_c = kUnset;
   double tyre_d = kUnset;
   double tyre_e = kUnset;
+  double tyre_bx = kUnset;
+  double tyre_dx = kUnset;
+  double tyre_load_nominal = kUnset;
+  double tyre_load_sensitivity = kUnset;
+  double relaxation_length_x = kUnset;
+  double relaxation_length_y = kUnset;
   // aero
   double c_down = kUnset;
   double aero_balance_front = kUnset;
   double c_drag = kUnset;
-  // drivetrain and brakes
-  double cm1 = kUnset;
-  double cr0 = kUnset;
+  // electric powertrain
+  double motor_torque_max = kUnset;
+  double motor_power_max = kUnset;
+  double motor_speed_max = kUnset;
+  double gear_ratio = kUnset;
+  double drivetrain_efficiency = kUnset;
+  double accumulator_power_max = kUnset;
+  double regen_torque_max = kUnset;
   double drive_split_front = kUnset;
+  double traction_control_slip = kUnset;
+  // brakes and rolling resistance
   double brake_force_max = kUnset;
   double brake_split_front = kUnset;
+  double cr0 = kUnset;
   // load transfer
   double pitch_time_constant = kUnset;
   // actuators
@@ -78,29 +102,44 @@ struct VehicleParams {
     v(PADDOCK_PARAM(track_front), {"m", params::in(0.5, 3.0), "distance between the front contact patches"});
     v(PADDOCK_PARAM(track_rear), {"m", params::in(0.5, 3.0), "distance between the rear contact patches"});
     v(PADDOCK_PARAM(wheel_radius), {"m", params::in(0.1, 0.6), "dynamic rolling radius"});
-    v(PADDOCK_PARAM(tyre_b), {"1/rad", params::above_up_to(0.0, 50.0), "Pacejka stiffness factor B"});
+    v(PADDOCK_PARAM(wheel_inertia), {"kg m^2", params::in(0.02, 5.0), "spin inertia of one wheel (tyre, rim, hub, brake disc)"});
+    v(PADDOCK_PARAM(driveline_inertia), {"kg m^2", params::in(0.0, 5.0), "motor rotor and gears of one driven wheel, reflected to the wheel (J_rotor gear_ratio^2)"});
+    v(PADDOCK_PARAM(tyre_b), {"1/rad", params::in(2.0, 50.0), "Pacejka stiffness factor B, lateral (of the slip angle)"});
     // C >= 2 would make the force change sign at large slip
-    v(PADDOCK_PARAM(tyre_c), {"", params::Bounds{0.0, 2.0, true, true}, "Pacejka shape factor C"});
+    v(PADDOCK_PARAM(tyre_c), {"", params::Bounds{0.0, 2.0, true, true}, "Pacejka shape factor C (lateral and longitudinal)"});
     // slicks on dry asphalt reach 1.5-1.8; no tyre reaches 3
-    v(PADDOCK_PARAM(tyre_d), {"", params::above_up_to(0.0, 3.0), "Pacejka peak friction coefficient D (also the friction ellipse radius)"});
+    v(PADDOCK_PARAM(tyre_d), {"", params::above_up_to(0.0, 3.0), "Pacejka peak friction D, lateral, at the nominal load"});
     // E <= 1 keeps B a - E (B a - atan(B a)) increasing in a
-    v(PADDOCK_PARAM(tyre_e), {"", params::at_most(1.0), "Pacejka curvature factor E"});
+    v(PADDOCK_PARAM(tyre_e), {"", params::in(-5.0, 1.0), "Pacejka curvature factor E (lateral and longitudinal)"});
+    v(PADDOCK_PARAM(tyre_bx), {"", params::in(2.0, 50.0), "Pacejka stiffness factor B, longitudinal (of the slip ratio)"});
+    v(PADDOCK_PARAM(tyre_dx), {"", params::above_up_to(0.0, 3.0), "Pacejka peak friction D, longitudinal, at the nominal load"});
+    v(PADDOCK_PARAM(tyre_load_nominal), {"N", params::in(50.0, 20000.0), "wheel load at which the peak frictions are tyre_d and tyre_dx"});
+    v(PADDOCK_PARAM(tyre_load_sensitivity), {"", params::in(-0.5, 0.0), "relative change of the peak friction per nominal load: D (1 + s (Fz / Fz0 - 1))"});
+    v(PADDOCK_PARAM(relaxation_length_x), {"m", params::in(0.02, 1.0), "longitudinal relaxation length of the tyre"});
+    v(PADDOCK_PARAM(relaxation_length_y), {"m", params::in(0.02, 1.0), "lateral relaxation length of the tyre"});
     v(PADDOCK_PARAM(c_down), {"N s^2/m^2", params::in(0.0, 20.0), "downforce F = c_down vx^2"});
     v(PADDOCK_PARAM(aero_balance_front), {"", params::fraction(), "share of the downforce on the front axle"});
     v(PADDOCK_PARAM(c_drag), {"N s^2/m^2", params::in(0.0, 20.0), "drag F = c_drag vx^2"});
-    v(PADDOCK_PARAM(cm1), {"N", params::in(0.0, 20000.0), "motor force at full throttle (all driven wheels)"});
-    v(PADDOCK_PARAM(cr0), {"N", params::in(0.0, 2000.0), "rolling resistance"});
-    v(PADDOCK_PARAM(drive_split_front), {"", params::fraction(), "share of the motor force on the front axle"});
-    v(PADDOCK_PARAM(brake_force_max), {"N", params::in(0.0, 20000.0), "total brake force at full brake"});
-    v(PADDOCK_PARAM(brake_split_front), {"", params::fraction(), "share of the brake force on the front axle (brake balance)"});
+    v(PADDOCK_PARAM(motor_torque_max), {"N m", params::above_up_to(0.0, 2000.0), "peak torque of all motors together, at the motor shafts"});
+    v(PADDOCK_PARAM(motor_power_max), {"W", params::above_up_to(0.0, 1e6), "peak mechanical power of all motors together (constant power above the base speed)"});
+    v(PADDOCK_PARAM(motor_speed_max), {"rad/s", params::above_up_to(0.0, 5000.0), "largest motor speed (the torque fades to 0 over its last 5 %)"});
+    v(PADDOCK_PARAM(gear_ratio), {"", params::in(1.0, 30.0), "motor speed / wheel speed"});
+    v(PADDOCK_PARAM(drivetrain_efficiency), {"", params::above_up_to(0.5, 1.0), "accumulator to wheels (inverter, motor, gears): P_wheels = eta P_accumulator"});
+    v(PADDOCK_PARAM(accumulator_power_max), {"W", params::above_up_to(0.0, 1e6), "largest power drawn from the accumulator (FS rules: 80 kW)"});
+    v(PADDOCK_PARAM(regen_torque_max), {"N m", params::in(0.0, 2000.0), "motor torque available for regenerative braking, at the motor shafts (0: no regeneration)"});
+    v(PADDOCK_PARAM(drive_split_front), {"", params::fraction(), "share of the drive torque on the front axle (0: rear-wheel drive)"});
+    v(PADDOCK_PARAM(traction_control_slip), {"", params::in(0.0, 1.0), "slip ratio above which the VCU cuts a wheel's drive torque (0: no traction control)"});
+    v(PADDOCK_PARAM(brake_force_max), {"N", params::in(0.0, 30000.0), "total brake torque at full brake, over the wheel radius"});
+    v(PADDOCK_PARAM(brake_split_front), {"", params::fraction(), "share of the brake torque on the front axle (brake balance)"});
+    v(PADDOCK_PARAM(cr0), {"N", params::in(0.0, 2000.0), "rolling resistance (a friction torque cr0 r / 4 on each wheel)"});
     v(PADDOCK_PARAM(pitch_time_constant), {"s", params::above_up_to(0.0, 5.0), "lag of the longitudinal load transfer behind the acceleration (pitch dynamics)"});
-    // below pi/2 so that tan(steering) of the kinematic model stays finite
+    // below pi/2 so that tan(steering) stays finite
     v(PADDOCK_PARAM(steering_max), {"rad", params::above_up_to(0.0, 1.5), "road-wheel angle limit (symmetric)"});
     v(PADDOCK_PARAM(steering_rate_max), {"rad/s", params::above_up_to(0.0, 20.0), "road-wheel angle rate limit"});
     v(PADDOCK_PARAM(steering_time_constant), {"s", params::in(0.0, 5.0), "first-order lag of the steering actuator (< dt/2: instantaneous)"});
     v(PADDOCK_PARAM(steering_dead_time), {"s", params::in(0.0, kMaxSteeringDeadTime), "pure delay on the steering command (rounded to whole steps)"});
-    v(PADDOCK_PARAM(throttle_time_constant), {"s", params::in(0.0, 5.0), "first-order lag of the motor force (< dt/2: instantaneous)"});
-    v(PADDOCK_PARAM(brake_time_constant), {"s", params::in(0.0, 5.0), "first-order lag of the brake force (< dt/2: instantaneous)"});
+    v(PADDOCK_PARAM(throttle_time_constant), {"s", params::in(0.0, 5.0), "first-order lag of the motor torque (< dt/2: instantaneous)"});
+    v(PADDOCK_PARAM(brake_time_constant), {"s", params::in(0.0, 5.0), "first-order lag of the brake torque (< dt/2: instantaneous)"});
     v(PADDOCK_PARAM(front_overhang), {"m", params::in(0.0, 3.0), "front axle to the front of the car (nose, front wing)"});
     v(PADDOCK_PARAM(rear_overhang), {"m", params::in(0.0, 3.0), "rear axle to the back of the car"});
     v(PADDOCK_PARAM(body_width), {"m", params::above_up_to(0.0, 3.0), "overall width (tyres included)"});
@@ -111,8 +150,9 @@ struct VehicleParams {
 // non-finite ones are replaced by safe values (steering: hold, throttle 0, brake 1).
 struct DriverInput {
   double steering_angle = 0.0;  // rad, road-wheel angle request, > 0 turns left
-  double throttle = 0.0;        // [0, 1], fraction of the maximum motor force cm1
-  double brake = 0.0;           // [0, 1], fraction of the maximum brake force
+  double throttle = 0.0;        // [0, 1], fraction of the motor torque limit (the power limit still applies)
+  double brake = 0.0;           // [0, 1], fraction of the maximum brake torque
+  double yaw_moment = 0.0;      // N m, torque vectoring: a left/right drive torque difference (> 0 counter-clockwise)
 };
 
 // the mutable state. A plain value type: copy it to fork a simulation.
@@ -136,6 +176,19 @@ struct VehicleState {
   double ax = 0.0;        // m/s^2
   double ay = 0.0;        // m/s^2
   double yaw_accel = 0.0; // rad/s^2
+  // the wheels FL, FR, RL, RR: spin, and the tyre's deflections that carry the
+  // slip (longitudinal slip ratio u_x / relaxation_length_x, slip angle
+  // atan(u_y / relaxation_length_y))
+  std::array<double, 4> omega{};  // rad/s, > 0 rolling forward
+  std::array<double, 4> u_x{};    // m
+  std::array<double, 4> u_y{};    // m, > 0 when the contact point moves left relative to the wheel
+  // energy drawn from the accumulator since the start (regeneration counts negative), J
+  double energy = 0.0;
+  // electrical power over the last step (RK4-weighted mean), W
+  double power = 0.0;
+  // the VCU's brake plausibility check (FS rules EV 2.3) has cut the motor
+  // torque: braking with more than 25 % throttle; cleared below 5 % throttle
+  bool torque_cut = false;
   // steering dead time: a ring buffer of past steering commands
   std::array<double, kMaxDelaySteps + 1> steering_delay{};  // rad
   std::size_t delay_head = 0;  // index of the slot the next command is written to
@@ -155,34 +208,48 @@ VehicleState rolling_state(const VehicleParams& p, Pose2 base_pose, double speed
 // one fixed step of length dt (s): RK4 over the whole state (rigid body and actuators)
 void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt);
 
-// lateral tyre force (N) at slip angle alpha (rad) and normal load fz (N); opposes the slip.
-// Linear in fz, so it serves one wheel or a whole axle.
+// the peak-friction factor of a wheel load fz (N): 1 + s (fz / Fz0 - 1), at least 0
+double load_factor(const VehicleParams& p, double fz);
+
+// the tyre's force (N, wheel frame: fx forward, fy left) at slip ratio kappa,
+// slip angle alpha (rad, > 0 when the contact point slides left) and load fz (N).
+// Pacejka's curve g(X) = sin(C atan(X - E (X - atan X))) on the combined
+// normalised slip X = |(B_x kappa, B alpha)|, shared out along its direction:
+//   fx = D_x L(fz) fz g(X) B_x kappa / X,   fy = -D L(fz) fz g(X) B alpha / X
+// (a friction ellipse on slip: each pure slip gives its own magic formula, the
+// forces saturate together on the ellipse of radii D_x, D)
+struct TyreForce {
+  double fx = 0.0;
+  double fy = 0.0;
+};
+TyreForce tyre_force(const VehicleParams& p, double kappa, double alpha, double fz);
+// the pure lateral force: tyre_force(p, 0, alpha, fz).fy
 double tyre_lateral_force(const VehicleParams& p, double alpha, double fz);
 
-// weight of the dynamic model in the low-speed blend: clamp(0.5 (|v| - 1.5), 0, 1)
-double dynamic_weight(double speed);
-
-// the slip angle (rad) of a wheel rolling at `steer` (rad, body frame) whose
-// contact point moves at (vx, vy) (body frame): atan2(vy, vx) - steer rolling
-// forwards, the angle from the backward direction rolling backwards; always
-// in (-pi/2, pi/2] when |steer| < pi/2
-double slip_angle(double vx, double vy, double steer);
+// the power the motors may deliver to the wheels (W): their own limit, and
+// the accumulator's times the drivetrain efficiency
+double drive_power_limit(const VehicleParams& p);
+// the wheel torque (N m, all driven wheels together) the motors deliver at
+// full throttle when each driven wheel turns at wheel_speed (rad/s): the motor
+// torque limit times the gear ratio, the motor power and the accumulator power
+// (times the drivetrain efficiency) over the wheel speed above the base speed,
+// fading to 0 over the last 5 % of the motor speed
+double drive_torque_limit(const VehicleParams& p, double wheel_speed);
+// the car's mass plus its wheels' and motors' rotating inertia seen at the
+// road, m + sum I_wheel / r^2 (kg): what a drive or brake force accelerates
+double equivalent_mass(const VehicleParams& p);
+// the car's top speed on a flat road, m/s: where the drive force at full
+// throttle meets drag and rolling resistance, or the motor speed limit
+double top_speed(const VehicleParams& p);
 
 // the longest physics step (s) the explicit RK4 integration stays stable at
-// for this car: 2.5 / lambda, lambda the faster of the linear single-track
-// model's lateral and yaw modes at the speed where the dynamic model starts
-// to count (1.5 m/s, dynamic_weight), where they are fastest (both grow as
-// 1 / v; downforce only adds a v^2 load that the 1 / v outweighs below
-// ~10 m/s). With C_f = B C D Fz_f, C_r likewise at the static axle loads:
-//   lateral  lambda_y = (C_f + C_r) / (m v)
-//   yaw      lambda_r = (C_f lf^2 + C_r lr^2) / (Iz v)
-// RK4's stability interval on the real axis is 2.785 / lambda; 2.5 keeps a
-// margin. The default car: lambda ~ 183 1/s, 13.6 ms (74 Hz).
+// for this car: 2.5 / lambda, lambda the fastest of the model's modes (see
+// vehicle.cc): the wheel's spin against the tyre's longitudinal stiffness,
+// the relaxation of the deflections at top speed, the chassis on the tyres'
+// lateral stiffness and the low-speed damping. RK4's stability interval is
+// 2.785 / lambda on the real axis and 2.83 / lambda on the imaginary one;
+// 2.5 keeps a margin.
 double stable_step_limit(const VehicleParams& p);
-
-// below this |vx| (m/s) rolling resistance and brakes fade linearly to zero, so that a
-// car at rest stays exactly at rest; chosen from dt for RK4 stability (see vehicle.cc)
-double standstill_speed(const VehicleParams& p, double dt);
 
 // pose of the base frame (rear axle centre) in the map
 Pose2 base_pose(const VehicleParams& p, const VehicleState& s);
@@ -196,9 +263,11 @@ double speed(const VehicleState& s);
 enum Wheel : std::size_t { kFrontLeft = 0, kFrontRight = 1, kRearLeft = 2, kRearRight = 3 };
 // contact patches in the map frame: FL, FR, RL, RR
 std::array<Vec2, 4> wheel_positions(const VehicleParams& p, const VehicleState& s);
-// wheel angular speeds, rad/s (> 0 rolling forward): the contact patch velocity along the
-// wheel heading over the rolling radius (no longitudinal slip model): FL, FR, RL, RR
+// wheel angular speeds, rad/s (> 0 rolling forward): the wheels' spin, FL, FR, RL, RR
 std::array<double, 4> wheel_speeds(const VehicleParams& p, const VehicleState& s);
+// each wheel's longitudinal slip ratio (omega r - v) / max(|v|, 1 m/s), v the
+// contact point's speed along the wheel: FL, FR, RL, RR
+std::array<double, 4> slip_ratios(const VehicleParams& p, const VehicleState& s);
 
 // the collision footprint: an axis-aligned rectangle in the base frame
 struct Footprint {

@@ -56,8 +56,8 @@ TEST(Scenario, DefaultLoadsWithTheVehicleFile) {
   const Scenario s = load_scenario(kDefault);
   EXPECT_EQ(s.name, "fsg_2023_trackdrive");
   EXPECT_EQ(s.scenario.event, events::EventKind::Trackdrive);
-  EXPECT_EQ(s.vehicle.mass, 190.0);  // ORACLES: the gotthard car
-  EXPECT_EQ(s.vehicle.tyre_b, 12.56);
+  EXPECT_EQ(s.vehicle.mass, 210.0);  // scenarios/vehicles/default.ini
+  EXPECT_EQ(s.vehicle.accumulator_power_max, 80000.0);
   EXPECT_TRUE(fs::exists(s.track_path)) << s.track_path;
   EXPECT_EQ(s.control.lateral, control::LateralMode::Combined);
 }
@@ -161,20 +161,27 @@ TEST_F(ScenarioFile, AVehicleOutsideThePhysicalRangeOrTooLargeAStepIsRejectedAtL
   EXPECT_THAT(error_of(write(std::string(kHead) + "[vehicle]\nmass = 1e308\n")), HasSubstr("[vehicle] mass = 1e308 is out of range"));
   EXPECT_THAT(error_of(write(std::string(kHead) + "[vehicle]\ninertia_z = 1e-300\n")), HasSubstr("[vehicle] inertia_z"));
   EXPECT_THAT(error_of(write(std::string(kHead) + "[vehicle]\ntyre_d = 1e6\n")), HasSubstr("[vehicle] tyre_d"));
-  // the default car's tyre modes: ~183 1/s at 1.5 m/s, so 10 Hz is unstable and 100 Hz is not
+  // the default car's fastest mode: the wheels' low-speed damping, ~454 1/s,
+  // so 10 and 100 Hz are unstable and 200 Hz is not
   EXPECT_THAT(error_of(write(std::string(kHead) + "[sim]\nphysics_rate = 10\ncontrol_rate = 10\nlog_rate = 10\n")),
-              HasSubstr("[sim] physics_rate must be at least 74 Hz for this vehicle"));
-  EXPECT_EQ(error_of(write(std::string(kHead) + "[sim]\nphysics_rate = 100\n")), "(no error)");
+              HasSubstr("[sim] physics_rate must be at least 182 Hz for this vehicle"));
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[sim]\nphysics_rate = 100\n")), HasSubstr("at least 182 Hz"));
+  EXPECT_EQ(error_of(write(std::string(kHead) + "[sim]\nphysics_rate = 200\n")), "(no error)");
 }
 
-TEST(Scenario, TheStableStepLimitIsTheLinearModelsFastestMode) {
-  // recomputed by hand for the default car: C = B C D m g / 2 per axle
+TEST(Scenario, TheStableStepLimitIsTheCarsFastestMode) {
+  // recomputed by hand for the default car, whose fastest mode is a rear
+  // wheel's spin against the tyre's low-speed damper (0.3 of critical for a
+  // quarter of the car on the slip stiffness C_k / sigma_x, C_k = B_x C D_x
+  // L(Fz) Fz at the static load): lambda = c r^2 / I
   const Scenario s = load_scenario(kDefault);
   const vehicle::VehicleParams& v = s.vehicle;
-  const double c_axle = v.tyre_b * v.tyre_c * v.tyre_d * v.mass * kGravity * 0.5;
-  const double lateral = 2.0 * c_axle / (v.mass * 1.5), yaw = 2.0 * c_axle * v.lf * v.lf / (v.inertia_z * 1.5);
-  EXPECT_NEAR(vehicle::stable_step_limit(v), 2.5 / std::max(lateral, yaw), 1e-12);
-  EXPECT_NEAR(vehicle::stable_step_limit(v), 0.0136, 0.0003);
+  const double fz = 0.5 * v.mass * kGravity * v.lf / (v.lf + v.lr);
+  const double c_kappa = v.tyre_bx * v.tyre_c * v.tyre_dx * vehicle::load_factor(v, fz) * fz;
+  const double damper = 0.3 * 2.0 * std::sqrt(c_kappa / v.relaxation_length_x * 0.25 * v.mass);
+  const double lambda = damper * v.wheel_radius * v.wheel_radius / (v.wheel_inertia + v.driveline_inertia);
+  EXPECT_NEAR(vehicle::stable_step_limit(v), 2.5 / lambda, 1e-12);
+  EXPECT_NEAR(vehicle::stable_step_limit(v), 0.0055, 0.0003);
 }
 
 TEST_F(ScenarioFile, AnOldKeyNamesItsNewPlace) {

@@ -31,8 +31,8 @@ std::vector<std::pair<std::string, double*>> fields_of(VehicleParams& p) {
 // a minimal reader of scenarios/vehicles/default.ini (the real scenario parser lives in
 // sim/runner): one [vehicle] section, `key = value ; comment` lines; every key must be a
 // field of VehicleParams, every field must appear exactly once
-VehicleParams load_default_params() {
-  const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/scenarios/vehicles/default.ini";
+VehicleParams load_car(const std::string& car) {
+  const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/scenarios/vehicles/" + car + ".ini";
   std::ifstream f(path);
   EXPECT_TRUE(f.good()) << "cannot open " << path;
   VehicleParams p;
@@ -69,12 +69,18 @@ VehicleParams load_default_params() {
     EXPECT_TRUE(known) << path << ":" << lineno << ": unknown key " << key;
     EXPECT_TRUE(seen.insert(key).second) << path << ":" << lineno << ": duplicate key " << key;
   }
-  EXPECT_EQ(seen.size(), fields.size()) << "default.ini must set every field";
+  EXPECT_EQ(seen.size(), fields.size()) << path << " must set every field";
   return p;
 }
 
 const VehicleParams& defaults() {
-  static const VehicleParams p = load_default_params();
+  static const VehicleParams p = load_car("default");
+  return p;
+}
+
+// the AMZ FSSIM car
+const VehicleParams& gotthard() {
+  static const VehicleParams p = load_car("gotthard");
   return p;
 }
 
@@ -95,7 +101,7 @@ VehicleState steady_corner(const VehicleParams& p, double v_target, double steer
                            VehicleState s) {
   const int n = static_cast<int>(std::lround(seconds / kDt));
   for (int k = 0; k < n; ++k) {
-    const double ff = (p.cr0 + p.c_drag * v_target * v_target) / p.cm1;
+    const double ff = (p.cr0 + p.c_drag * v_target * v_target) * p.wheel_radius / drive_torque_limit(p, 0.0);
     const double thr = std::clamp(ff + 0.5 * (v_target - s.vx), 0.0, 1.0);
     step(p, s, DriverInput{steering, thr, 0.0}, kDt);
   }
@@ -116,6 +122,12 @@ void expect_states_equal(const VehicleState& a, const VehicleState& b) {
   EXPECT_EQ(a.ax, b.ax);
   EXPECT_EQ(a.ay, b.ay);
   EXPECT_EQ(a.yaw_accel, b.yaw_accel);
+  EXPECT_EQ(a.omega, b.omega);
+  EXPECT_EQ(a.u_x, b.u_x);
+  EXPECT_EQ(a.u_y, b.u_y);
+  EXPECT_EQ(a.energy, b.energy);
+  EXPECT_EQ(a.power, b.power);
+  EXPECT_EQ(a.torque_cut, b.torque_cut);
   EXPECT_EQ(a.steering_delay, b.steering_delay);
   EXPECT_EQ(a.delay_head, b.delay_head);
 }
@@ -137,8 +149,10 @@ TEST(VehicleParams, TheVisitListsEveryFieldOnce) {
   }
 }
 
-TEST(VehicleParams, DefaultIniSetsEveryFieldAndValidates) {
-  const VehicleParams& p = defaults();
+TEST(VehicleParams, TheCarFilesSetEveryFieldAndValidate) {
+  EXPECT_EQ(params::validate(defaults()), "");
+  EXPECT_EQ(defaults().accumulator_power_max, 80000.0);  // the FS rules' limit
+  const VehicleParams& p = gotthard();
   EXPECT_EQ(params::validate(p), "");
   // the ORACLES.md gotthard figures
   EXPECT_EQ(p.mass, 190.0);
@@ -168,7 +182,7 @@ TEST(VehicleParams, ValidateNamesTheFieldAndWhatWasExpected) {
   // a field left unset (NaN) is named
   p = defaults();
   p.brake_force_max = kUnset;
-  EXPECT_EQ(params::validate(p), "brake_force_max must be in [0, 20000] N (got nan)");
+  EXPECT_EQ(params::validate(p), "brake_force_max must be in [0, 30000] N (got nan)");
 
   // a default-constructed set is rejected at its first field
   EXPECT_EQ(params::validate(VehicleParams{}), "mass must be in [50, 2000] kg (got nan)");
@@ -179,8 +193,8 @@ TEST(VehicleParams, ValidateNamesTheFieldAndWhatWasExpected) {
 // ---------------------------------------------------------------------------
 
 TEST(Tyre, MatchesFssimOracle) {
-  // ORACLES.md: per wheel at Fz = 465.975 N (= 190 kg g / 4)
-  const VehicleParams& p = defaults();
+  // ORACLES.md: per wheel at Fz = 465.975 N (= 190 kg g / 4), gotthard's tyre
+  const VehicleParams& p = gotthard();
   const double fz = 465.975;
   EXPECT_NEAR(std::abs(tyre_lateral_force(p, 0.05, fz)), 540.906, 1e-3);
   EXPECT_NEAR(std::abs(tyre_lateral_force(p, 0.10, fz)), 725.869, 1e-3);
@@ -191,24 +205,52 @@ TEST(Tyre, MatchesFssimOracle) {
   EXPECT_EQ(tyre_lateral_force(p, 0.0, fz), 0.0);
 }
 
-TEST(Tyre, DynamicWeightIsTheFssimBlend) {
-  EXPECT_EQ(dynamic_weight(0.0), 0.0);
-  EXPECT_EQ(dynamic_weight(1.5), 0.0);
-  EXPECT_EQ(dynamic_weight(2.5), 0.5);
-  EXPECT_EQ(dynamic_weight(3.5), 1.0);
-  EXPECT_EQ(dynamic_weight(30.0), 1.0);
+// the magic formula written out, for one direction
+double magic(double b, double c, double d, double e, double x) {
+  return d * std::sin(c * std::atan(b * x - e * (b * x - std::atan(b * x))));
+}
+
+TEST(Tyre, PureSlipIsEachMagicFormulaAndCombinedSlipStaysOnTheEllipse) {
+  const VehicleParams& p = defaults();
+  for (const double fz : {200.0, 500.0, 900.0}) {
+    const double mu = 1.0 + p.tyre_load_sensitivity * (fz / p.tyre_load_nominal - 1.0);
+    for (const double s : {-0.5, -0.1, -0.02, 0.01, 0.08, 0.3, 1.0}) {
+      EXPECT_NEAR(tyre_force(p, s, 0.0, fz).fx, mu * fz * magic(p.tyre_bx, p.tyre_c, p.tyre_dx, p.tyre_e, s), 1e-9);
+      EXPECT_NEAR(tyre_force(p, 0.0, s, fz).fy, -mu * fz * magic(p.tyre_b, p.tyre_c, p.tyre_d, p.tyre_e, s), 1e-9);
+      EXPECT_EQ(tyre_force(p, s, 0.0, fz).fy, 0.0);
+    }
+    // combined: inside the friction ellipse of radii D_x mu fz, D mu fz, and
+    // each force smaller than its pure-slip value
+    for (const double kappa : {-0.3, -0.05, 0.02, 0.1, 0.6}) {
+      for (const double alpha : {-0.4, -0.03, 0.05, 0.2}) {
+        const TyreForce f = tyre_force(p, kappa, alpha, fz);
+        const double ex = f.fx / (p.tyre_dx * mu * fz), ey = f.fy / (p.tyre_d * mu * fz);
+        EXPECT_LE(ex * ex + ey * ey, 1.0 + 1e-12);
+        EXPECT_LE(std::abs(f.fx), std::abs(tyre_force(p, kappa, 0.0, fz).fx) + 1e-9);
+        EXPECT_LE(std::abs(f.fy), std::abs(tyre_force(p, 0.0, alpha, fz).fy) + 1e-9);
+        EXPECT_GT(f.fx * kappa, 0.0);   // drives when the wheel is faster than the road
+        EXPECT_LT(f.fy * alpha, 0.0);   // opposes the sliding
+      }
+    }
+  }
+  // load sensitivity: the peak (brute force over the slip) of twice the nominal
+  // load is (1 + s) D 2 Fz0
+  double peak = 0.0;
+  for (int k = 1; k < 4000; ++k) peak = std::max(peak, -tyre_lateral_force(p, k * 1e-4, 2.0 * p.tyre_load_nominal));
+  EXPECT_NEAR(peak, (1.0 + p.tyre_load_sensitivity) * p.tyre_d * 2.0 * p.tyre_load_nominal, 1e-3 * peak);
 }
 
 // ---------------------------------------------------------------------------
-// standstill
+// standstill (fault 4: static friction)
 // ---------------------------------------------------------------------------
 
 TEST(Standstill, AtRestWithZeroInputStaysExactlyAtRest) {
-  const VehicleParams& p = defaults();
-  const VehicleState s0 = initial_state(p, Pose2{3.0, -2.0, 0.7});
-  VehicleState s = s0;
-  for (int i = 0; i < 10000; ++i) step(p, s, DriverInput{}, kDt);  // 10 s
-  expect_states_equal(s, s0);
+  for (const VehicleParams* p : {&defaults(), &gotthard()}) {
+    const VehicleState s0 = initial_state(*p, Pose2{3.0, -2.0, 0.7});
+    VehicleState s = s0;
+    for (int i = 0; i < 10000; ++i) step(*p, s, DriverInput{}, kDt);  // 10 s
+    expect_states_equal(s, s0);
+  }
 }
 
 TEST(Standstill, AtRestWithBrakesAndSteeringDoesNotCreep) {
@@ -225,137 +267,305 @@ TEST(Standstill, AtRestWithBrakesAndSteeringDoesNotCreep) {
   EXPECT_NEAR(s.steering, 0.3, 1e-12);
 }
 
+// the throttle whose drive force (at the torque limit) is `force` N
+double throttle_for(const VehicleParams& p, double force) {
+  return force * p.wheel_radius / (p.motor_torque_max * p.gear_ratio);
+}
+
+TEST(Standstill, ADriveForceBelowTheBreakawayForceMovesNothing) {
+  // rolling resistance is a friction torque cr0 r / 4 per wheel: a drive force
+  // below cr0 must not move the car at all (it crept 1.3 m a minute at 2 %
+  // throttle), one above it must
+  for (const VehicleParams* p : {&defaults(), &gotthard()}) {
+    VehicleState s = initial_state(*p, Pose2{});
+    const VehicleState s0 = s;
+    for (int i = 0; i < 60000; ++i) step(*p, s, DriverInput{0.0, throttle_for(*p, 0.9 * p->cr0), 0.0}, kDt);
+    EXPECT_EQ(s.x, s0.x);
+    EXPECT_EQ(s.vx, 0.0);
+    for (const double w : s.omega) EXPECT_EQ(w, 0.0);
+    for (int i = 0; i < 5000; ++i) step(*p, s, DriverInput{0.0, throttle_for(*p, 1.3 * p->cr0), 0.0}, kDt);
+    EXPECT_GT(s.x - s0.x, 0.01);
+  }
+}
+
+TEST(Standstill, BrakesHoldTheMotor) {
+  const VehicleParams& p = defaults();
+  // a drive torque below the brakes' on every wheel: held, exactly
+  double t_brake_min = std::min(p.brake_split_front, 1.0 - p.brake_split_front) * 0.5 * p.brake_force_max;
+  const double throttle = std::min(0.24, 0.9 * t_brake_min / (0.5 * std::max(p.drive_split_front, 1.0 - p.drive_split_front) *
+                                               p.motor_torque_max * p.gear_ratio / p.wheel_radius));
+  VehicleState s = initial_state(p, Pose2{});
+  const VehicleState s0 = s;
+  for (int i = 0; i < 60000; ++i) step(p, s, DriverInput{0.0, throttle, 1.0}, kDt);
+  EXPECT_EQ(s.x, s0.x);
+  EXPECT_FALSE(s.torque_cut);
+  // full throttle with the brake on: the brake plausibility check (FS rules
+  // EV 2.3) cuts the motors (it accelerated against the brakes before), and
+  // keeps them cut after the brake is released until the throttle drops
+  // below 5 %
+  for (const VehicleParams* car : {&defaults(), &gotthard()}) {
+    s = initial_state(*car, Pose2{});
+    const double x0 = s.x;
+    for (int i = 0; i < 60000; ++i) step(*car, s, DriverInput{0.0, 1.0, 1.0}, kDt);
+    EXPECT_EQ(s.x, x0);
+    EXPECT_TRUE(s.torque_cut);
+    for (int i = 0; i < 1000; ++i) step(*car, s, DriverInput{0.0, 1.0, 0.0}, kDt);
+    EXPECT_EQ(s.x, x0);
+    step(*car, s, DriverInput{0.0, 0.0, 0.0}, kDt);
+    for (int i = 0; i < 1000; ++i) step(*car, s, DriverInput{0.0, 1.0, 0.0}, kDt);
+    EXPECT_GT(s.x - x0, 1.0);
+  }
+}
+
 // ---------------------------------------------------------------------------
 // longitudinal
 // ---------------------------------------------------------------------------
 
-// m dv/dt = F - Cr0 - c v^2 with v_inf = sqrt((F - Cr0) / c) has the solution
-//   v(t) = v_inf tanh(c v_inf t / m + atanh(v0 / v_inf)).
-double analytic_speed(const VehicleParams& p, double force, double v0, double t) {
-  const double v_inf = std::sqrt((force - p.cr0) / p.c_drag);
-  return v_inf * std::tanh(p.c_drag * v_inf * t / p.mass + std::atanh(v0 / v_inf));
+// the car's mass plus its rotating parts seen at the road: m + sum I / r^2
+double effective_mass(const VehicleParams& p) {
+  double m = p.mass;
+  for (int i = 0; i < 4; ++i) {
+    const bool driven = i < 2 ? p.drive_split_front > 0.0 : p.drive_split_front < 1.0;
+    m += (p.wheel_inertia + (driven ? p.driveline_inertia : 0.0)) / (p.wheel_radius * p.wheel_radius);
+  }
+  return m;
 }
 
-TEST(Longitudinal, StraightLineAccelerationMatchesTanhSolution) {
-  // throttle 0.3: 1500 N, half per axle (750 N) against a friction limit of
-  // D Fz > 1.6 (931.95 - 225) N = 1131 N per axle even with the full load transfer
-  const VehicleParams p = instant_actuators();
-  const double throttle = 0.3;
-  const double force = throttle * p.cm1;
-  const DriverInput in{0.0, throttle, 0.0};
-
-  // from a rolling start (above the standstill band): the model is exactly the ODE
-  // above (kinematic and dynamic rows agree on a straight line), so only RK4's
-  // truncation error remains, O(dt^4) ~ 1e-12 here: tolerance 1e-9 m/s
-  {
-    const double v0 = 2.0;
-    VehicleState s = moving_state(p, v0);
+TEST(Longitudinal, CoastDownMatchesItsClosedFormWithTheRotatingInertia) {
+  // m_eff v' = -(c v^2 + Cr):  v(t) = sqrt(Cr / c) tan(atan(v0 sqrt(c / Cr)) - sqrt(c Cr) t / m_eff)
+  for (const VehicleParams* p : {&defaults(), &gotthard()}) {
+    const double m_eff = effective_mass(*p);
+    const double c = p->c_drag, cr = p->cr0, v0 = 25.0;
+    auto closed = [&](double t) {
+      return std::sqrt(cr / c) * std::tan(std::atan(v0 * std::sqrt(c / cr)) - std::sqrt(c * cr) * t / m_eff);
+    };
+    // without the rotating inertia the car would be this much slower at 10 s
+    ASSERT_GT(closed(10.0) - std::sqrt(cr / c) * std::tan(std::atan(v0 * std::sqrt(c / cr)) - std::sqrt(c * cr) * 10.0 / p->mass), 0.05 * closed(10.0) * (m_eff - p->mass) / m_eff);
+    VehicleState s = rolling_state(*p, Pose2{}, v0);
     int k = 0;
-    for (double t_check : {0.5, 1.0, 2.0, 5.0, 10.0, 20.0}) {
-      while (k < static_cast<int>(std::lround(t_check / kDt))) {
-        step(p, s, in, kDt);
-        ++k;
-      }
-      EXPECT_NEAR(s.vx, analytic_speed(p, force, v0, t_check), 1e-9) << "t = " << t_check;
-      EXPECT_EQ(s.vy, 0.0);
-      EXPECT_EQ(s.r, 0.0);
+    for (const double t_check : {1.0, 3.0, 6.0, 10.0}) {
+      for (; k < static_cast<int>(std::lround(t_check / kDt)); ++k) step(*p, s, DriverInput{}, kDt);
+      ASSERT_GT(closed(t_check), 1.0);
+      EXPECT_NEAR(s.vx, closed(t_check), 0.01 * closed(t_check)) << "t = " << t_check;
     }
   }
+}
 
-  // from rest: below v_reg the rolling resistance is regularised to Cr0 vx / v_reg, so
-  // while crossing the band (at most v_reg / a_min seconds, a_min = (F - Cr0) / m) the
-  // car gains less than the missing Cr0 / m: dv < Cr0 / m * v_reg / a_min = 5.3e-3 m/s
-  // (v_reg = 3.9 cm/s; about half of that on average), and drag then shrinks the
-  // excess. Tolerance: that bound.
-  {
-    const double v_reg = standstill_speed(p, kDt);
-    const double a_min = (force - p.cr0) / p.mass;
-    const double tol = p.cr0 / p.mass * v_reg / a_min;
+TEST(Longitudinal, APowerLimitedLaunchMatchesTheOde) {
+  // grip to spare (D = 3, a stiff tyre: the slip stays below 1 %, no load
+  // transfer to unload the front), instant actuators: the car follows m_eff v' = min(T g, P r / v) / r - c v^2 - Cr
+  // with T the motor torque limit, g the gear ratio, P the smaller of the
+  // motor power and eta x the accumulator's; the ODE integrated here with
+  // RK4 at 0.1 ms, the comparison below the motor speed fade
+  for (VehicleParams p : {instant_actuators(), gotthard()}) {
+    p.throttle_time_constant = 0.0;
+    p.tyre_d = p.tyre_dx = 3.0;
+    p.tyre_bx = 50.0;
+    p.tyre_load_sensitivity = 0.0;
+    p.h_cg = 0.0;
+    const double m_eff = effective_mass(p);
+    const double power = std::min(p.motor_power_max, p.drivetrain_efficiency * p.accumulator_power_max);
+    auto accel = [&](double v) {
+      const double force = std::min(p.motor_torque_max * p.gear_ratio, v > 0.0 ? power * p.wheel_radius / v : 1e300) / p.wheel_radius;
+      return (force - p.c_drag * v * v - p.cr0) / m_eff;
+    };
+    const double v_fade = 0.95 * p.motor_speed_max / p.gear_ratio * p.wheel_radius;
+    double v_ode = 0.0, t_ode = 0.0;
     VehicleState s = initial_state(p, Pose2{});
-    int k = 0;
-    for (double t_check : {0.5, 1.0, 2.0, 5.0, 10.0, 20.0}) {
-      while (k < static_cast<int>(std::lround(t_check / kDt))) {
-        step(p, s, in, kDt);
-        ++k;
+    int k = 0, checks = 0;
+    for (const double t_check : {0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, 8.0}) {
+      for (; k < static_cast<int>(std::lround(t_check / kDt)); ++k) step(p, s, DriverInput{0.0, 1.0, 0.0}, kDt);
+      for (const double h = 1e-4; t_ode < t_check - 0.5 * h; t_ode += h) {
+        const double a1 = accel(v_ode), a2 = accel(v_ode + 0.5 * h * a1), a3 = accel(v_ode + 0.5 * h * a2), a4 = accel(v_ode + h * a3);
+        v_ode += h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
       }
-      const double expected = analytic_speed(p, force, 0.0, t_check);
-      EXPECT_NEAR(s.vx, expected, tol) << "t = " << t_check;
-      EXPECT_GE(s.vx, expected) << "the regularisation can only help";
+      if (v_ode > v_fade) break;
+      EXPECT_NEAR(s.vx, v_ode, 0.01 * v_ode) << "t = " << t_check;
+      ++checks;
+    }
+    EXPECT_GE(checks, 4);
+    EXPECT_GT(v_ode * accel(v_ode) * m_eff, 0.0);
+  }
+}
+
+TEST(Longitudinal, TheDefaultCarIsAnFsCar) {
+  // issue 17's acceptance: 75 m from rest in 3.3-4.5 s; top speed set by the
+  // motor or the power (not the old 299 km/h); braking from 100 km/h at 1.5-2 g
+  const VehicleParams& p = defaults();
+  VehicleState s = initial_state(p, Pose2{});
+  double t = 0.0;
+  while (s.x - p.lr < 75.0 && t < 10.0) {
+    step(p, s, DriverInput{0.0, 1.0, 0.0}, kDt);
+    t += kDt;
+  }
+  EXPECT_GE(t, 3.3);
+  EXPECT_LE(t, 4.5);
+  for (int k = 0; k < 60000; ++k) step(p, s, DriverInput{0.0, 1.0, 0.0}, kDt);
+  const double v_motor = p.motor_speed_max / p.gear_ratio * p.wheel_radius;
+  const double power = std::min(p.motor_power_max, p.drivetrain_efficiency * p.accumulator_power_max);
+  EXPECT_LE(s.vx, v_motor);
+  EXPECT_LE(s.vx * (p.c_drag * s.vx * s.vx + p.cr0), power * 1.001);
+  EXPECT_NEAR(s.vx, top_speed(p), 0.01 * top_speed(p));
+  const double v0 = 100.0 / 3.6;
+  double best = 1e9;
+  for (double pedal = 0.3; pedal <= 1.0 + 1e-9; pedal += 0.05) {
+    s = rolling_state(p, Pose2{}, v0);
+    for (int k = 0; k < 10000 && s.vx > 0.0; ++k) step(p, s, DriverInput{0.0, 0.0, pedal}, kDt);
+    best = std::min(best, s.x - p.lr);
+  }
+  const double g_braking = v0 * v0 / (2.0 * best) / kGravity;
+  EXPECT_GE(g_braking, 1.5);
+  EXPECT_LE(g_braking, 2.0);
+  std::printf("default car: 75 m in %.3f s, top speed %.1f km/h, braking from 100 km/h in %.2f m (%.2f g)\n", t,
+              top_speed(p) * 3.6, best, g_braking);
+}
+
+TEST(Longitudinal, WheelsSpinOnLowGripAndLockUnderFullBrakingWithoutAbs) {
+  // mu 0.6, full throttle from rest, no traction control: the wheel speeds
+  // show more than 10 % slip
+  VehicleParams p = defaults();
+  p.tyre_d = p.tyre_dx = 0.6;
+  p.traction_control_slip = 0.0;
+  VehicleState s = initial_state(p, Pose2{});
+  for (int k = 0; k < 2000; ++k) step(p, s, DriverInput{0.0, 1.0, 0.0}, kDt);
+  for (const int i : {kRearLeft, kFrontLeft}) {
+    const double v_wheel = s.omega[i] * p.wheel_radius;
+    EXPECT_GT((v_wheel - s.vx) / s.vx, 0.1) << "wheel " << i;
+  }
+  // with traction control the slip settles near its threshold
+  p.traction_control_slip = 0.1;
+  s = initial_state(p, Pose2{});
+  for (int k = 0; k < 3000; ++k) step(p, s, DriverInput{0.0, 1.0, 0.0}, kDt);
+  for (const double kappa : slip_ratios(p, s)) EXPECT_LT(kappa, 0.3);
+  // full brake from 20 m/s on the default car: the front wheels lock while it still moves
+  const VehicleParams& d = defaults();
+  s = rolling_state(d, Pose2{}, 20.0);
+  bool locked = false;
+  while (s.vx > 5.0) {
+    step(d, s, DriverInput{0.0, 0.0, 1.0}, kDt);
+    locked = locked || (s.omega[kFrontLeft] == 0.0 && s.omega[kFrontRight] == 0.0);
+  }
+  EXPECT_TRUE(locked);
+}
+
+TEST(Longitudinal, BrakingStopsAndTheCarStaysAtRest) {
+  for (const VehicleParams* p : {&defaults(), &gotthard()}) {
+    VehicleState s = rolling_state(*p, Pose2{}, 15.0);
+    const double v0 = 15.0;
+    int stop_step = -1;
+    for (int k = 0; k < 10000 && stop_step < 0; ++k) {
+      step(*p, s, DriverInput{0.0, 0.0, 1.0}, kDt);
+      // the deceleration never beats the friction limit plus drag and rolling resistance
+      if (s.vx < 1e-3) stop_step = k;
+    }
+    ASSERT_GE(stop_step, 0) << "did not stop";
+    const double a_bound = std::max(p->tyre_d, p->tyre_dx) * (kGravity + p->c_down * v0 * v0 / p->mass) +
+                           (p->c_drag * v0 * v0 + p->cr0) / p->mass;
+    EXPECT_GT(stop_step * kDt, v0 / a_bound);
+    EXPECT_LT(stop_step * kDt, 2.0);
+    // then at rest: the tyres' deflection settles in a few cm, nothing creeps
+    const VehicleState stopped = s;
+    for (int k = 0; k < 5000; ++k) step(*p, s, DriverInput{0.0, 0.0, 1.0}, kDt);
+    EXPECT_LT(std::abs(s.x - stopped.x), 0.05);
+    const VehicleState settled = s;
+    for (int k = 0; k < 5000; ++k) step(*p, s, DriverInput{0.0, 0.0, 1.0}, kDt);
+    EXPECT_LT(std::abs(s.x - settled.x), 1e-6);
+    EXPECT_LT(std::abs(s.vx), 1e-6);
+  }
+}
+
+TEST(Longitudinal, TheAccumulatorEnergyCoversTheWorkAndRegenerationReturnsSome) {
+  // a launch to 20 m/s at 30 % throttle without drag or rolling resistance:
+  // eta x the energy drawn is the kinetic energy gained (car and rotating
+  // parts) plus the tyres' slip losses, a few %
+  VehicleParams p = defaults();
+  p.c_drag = 0.0;
+  p.cr0 = 0.0;
+  VehicleState s = initial_state(p, Pose2{});
+  while (s.vx < 20.0) step(p, s, DriverInput{0.0, 0.3, 0.0}, kDt);
+  double kinetic = 0.5 * p.mass * s.vx * s.vx;
+  for (int i = 0; i < 4; ++i) kinetic += 0.5 * (p.wheel_inertia + p.driveline_inertia) * s.omega[i] * s.omega[i];
+  const double work = p.drivetrain_efficiency * s.energy;
+  EXPECT_GE(work, kinetic);
+  EXPECT_LE(work, 1.05 * kinetic);
+  // braking back: regeneration returns energy, at most eta x the kinetic energy
+  const double e_before = s.energy;
+  while (s.vx > 0.5) step(p, s, DriverInput{0.0, 0.0, 0.4}, kDt);
+  EXPECT_LT(s.energy, e_before - 0.2 * kinetic);
+  EXPECT_GT(s.energy, e_before - p.drivetrain_efficiency * kinetic);
+  // without regeneration nothing comes back
+  p.regen_torque_max = 0.0;
+  s = rolling_state(p, Pose2{}, 20.0);
+  while (s.vx > 0.5) step(p, s, DriverInput{0.0, 0.0, 0.4}, kDt);
+  EXPECT_EQ(s.energy, 0.0);
+}
+
+// ---------------------------------------------------------------------------
+// energy (fault 2), bounded accelerations (fault 3), spinning (fault 1)
+// ---------------------------------------------------------------------------
+
+// kinetic energy of the car and its rotating parts, J
+double kinetic_energy(const VehicleParams& p, const VehicleState& s) {
+  double e = 0.5 * p.mass * (s.vx * s.vx + s.vy * s.vy) + 0.5 * p.inertia_z * s.r * s.r;
+  for (int i = 0; i < 4; ++i) {
+    const bool driven = i < 2 ? p.drive_split_front > 0.0 : p.drive_split_front < 1.0;
+    e += 0.5 * (p.wheel_inertia + (driven ? p.driveline_inertia : 0.0)) * s.omega[i] * s.omega[i];
+  }
+  return e;
+}
+
+TEST(Energy, KineticEnergyNeverGrowsWithoutDriveInAnyRegime) {
+  // no drive, drag or rolling resistance; the tyres start undeflected, so the
+  // kinetic energy is bounded by its start (the deflections' energy is >= 0):
+  // at 2 m/s on full lock (it grew by 168 % in the old blend), steering to and
+  // fro at walking pace (+16 %), a slalom at 15 m/s, a slide into the low
+  // speeds (the old blend's band)
+  for (const VehicleParams* car : {&defaults(), &gotthard()}) {
+    VehicleParams p = *car;
+    p.c_drag = 0.0;
+    p.cr0 = 0.0;
+    struct Case {
+      double v0, vy0, r0;
+      double (*steer)(double t);
+    };
+    const Case cases[] = {
+        {2.0, 0.0, 0.0, [](double) { return 0.52; }},
+        {1.0, 0.0, 0.0, [](double t) { return 0.5 * std::sin(3.0 * t); }},
+        {15.0, 0.0, 0.0, [](double t) { return 0.15 * std::sin(kPi * t); }},
+        {4.0, 2.5, 1.5, [](double) { return -0.3; }},
+    };
+    for (const Case& c : cases) {
+      VehicleState s = rolling_state(p, Pose2{}, c.v0);
+      s.vy = c.vy0;
+      s.r = c.r0;
+      const double e0 = kinetic_energy(p, s);
+      double e_max = e0;
+      for (int k = 0; k < 10000; ++k) {
+        step(p, s, DriverInput{c.steer(k * kDt), 0.0, 0.0}, kDt);
+        e_max = std::max(e_max, kinetic_energy(p, s));
+      }
+      EXPECT_LE(e_max, e0 * (1.0 + 1e-9)) << "v0 " << c.v0;
+      EXPECT_LT(kinetic_energy(p, s), e0);
     }
   }
 }
 
-TEST(Longitudinal, BrakingStopsNeverReversesAndStaysAtRest) {
-  const VehicleParams& p = defaults();
-  VehicleState s = moving_state(p, 15.0);
-  const DriverInput in{0.0, 0.0, 1.0};
-  double min_vx = s.vx;
-  int stop_step = -1;
-  double x_stop = 0.0;
-  for (int k = 0; k < 10000; ++k) {
-    const double vx_before = s.vx;
-    step(p, s, in, kDt);
-    min_vx = std::min(min_vx, s.vx);
-    // the deceleration never beats the friction limit plus drag and rolling resistance
-    const double decel = (vx_before - s.vx) / kDt;
-    const double bound =
-        p.tyre_d * (kGravity + p.c_down * vx_before * vx_before / p.mass) +
-        (p.c_drag * vx_before * vx_before + p.cr0) / p.mass;
-    EXPECT_LE(decel, bound * 1.001) << "k = " << k;
-    if (stop_step < 0 && s.vx < 1e-6) stop_step = k;
-    if (stop_step >= 0 && k == stop_step + 1000) x_stop = s.x;
-  }
-  ASSERT_GE(stop_step, 0) << "did not stop";
-  EXPECT_GE(min_vx, 0.0) << "rolled backwards";
-  // the stopping time is at least v0 / (the deceleration bound above, at its largest,
-  // v = v0), and a car with brakes that reach the tyre limit stops within 2 s
-  const double v0 = 15.0;
-  const double a_bound = p.tyre_d * (kGravity + p.c_down * v0 * v0 / p.mass) + (p.c_drag * v0 * v0 + p.cr0) / p.mass;
-  EXPECT_GT(stop_step * kDt, v0 / a_bound);
-  EXPECT_LT(stop_step * kDt, 2.0);
-  // then at rest: inside the standstill band vx decays like exp(-t / tau) with
-  // tau = m v_reg / F ~ 2 ms, so one second after the stop the car does not move at all
-  ASSERT_LT(stop_step + 1000, 10000);
-  EXPECT_EQ(s.x, x_stop);
-  EXPECT_LT(s.vx, 1e-200);
-  EXPECT_EQ(s.y, 0.0);
-  EXPECT_EQ(s.yaw, 0.0);
-  std::printf("braking from %.0f m/s: stopped after %.3f s in %.2f m\n", v0, stop_step * kDt, s.x);
-}
-
-TEST(Longitudinal, BrakingInACornerStopsAndStopsTurning) {
-  // through the blend into the kinematic model with a residual sideslip: vy and r must
-  // settle on their kinematic values (zero at vx = 0), so the car does not spin in place
-  const VehicleParams& p = defaults();
-  VehicleState s = steady_corner(p, 10.0, 0.1, 3.0, moving_state(p, 10.0));
-  ASSERT_GT(std::abs(s.vy), 1e-3);
-  for (int k = 0; k < 5000; ++k) {
-    step(p, s, DriverInput{0.1, 0.0, 1.0}, kDt);
-    EXPECT_GE(s.vx, 0.0) << "k = " << k;
-  }
-  const VehicleState stopped = s;
-  EXPECT_LT(std::abs(s.r), 1e-9);
-  EXPECT_LT(std::abs(s.vy), 1e-9);
-  for (int k = 0; k < 5000; ++k) step(p, s, DriverInput{0.1, 0.0, 1.0}, kDt);
-  EXPECT_NEAR(s.yaw, stopped.yaw, 1e-9);
-  EXPECT_NEAR(s.x, stopped.x, 1e-9);
-  EXPECT_NEAR(s.y, stopped.y, 1e-9);
-}
-
-TEST(Lateral, SlipAngleOpposesTheLateralVelocityInEveryDirectionOfTravel) {
-  // forwards it is the textbook atan2(vy, vx) - steer, to the bit
-  EXPECT_EQ(slip_angle(10.0, 1.0, 0.1), std::atan2(1.0, 10.0) - 0.1);
-  // backwards: the same magnitude as forwards, its sign that of the lateral velocity
-  EXPECT_NEAR(slip_angle(-10.0, 1.0, 0.0), std::atan(1.0 / 10.0), 1e-12);
-  EXPECT_NEAR(slip_angle(-10.0, -1.0, 0.0), -std::atan(1.0 / 10.0), 1e-12);
-  // a steered wheel rolling backwards: the velocity in the wheel frame, by rotation
-  for (const double steer : {-0.5, -0.1, 0.2, 0.5}) {
-    for (const double vy : {-3.0, -0.2, 0.0, 0.7, 4.0}) {
-      const double v_long = -6.0 * std::cos(steer) + vy * std::sin(steer);
-      const double v_lat = 6.0 * std::sin(steer) + vy * std::cos(steer);
-      EXPECT_NEAR(slip_angle(-6.0, vy, steer), std::atan(v_lat / std::abs(v_long)), 1e-12) << steer << " " << vy;
-      EXPECT_LE(std::abs(slip_angle(-6.0, vy, steer)), kPi / 2);
+TEST(Energy, AccelerationsStayBoundedFromASlideToRest) {
+  // a car sliding sideways into the low speeds: its acceleration never beats
+  // what the tyres can carry (it was pulled to the kinematic values in 10 ms:
+  // 16 g), here D g (1 + downforce) with 10 % for the load transfer
+  for (const VehicleParams* p : {&defaults(), &gotthard()}) {
+    VehicleState s = rolling_state(*p, Pose2{}, 6.0);
+    s.vy = 3.0;
+    s.r = -1.0;
+    const double bound = 1.1 * std::max(p->tyre_d, p->tyre_dx) * (kGravity + p->c_down * 36.0 / p->mass);
+    double worst = 0.0;
+    for (int k = 0; k < 8000; ++k) {
+      step(*p, s, DriverInput{0.2, 0.0, k < 4000 ? 0.0 : 0.5}, kDt);
+      worst = std::max(worst, std::hypot(s.ax, s.ay));
     }
+    EXPECT_LE(worst, bound);
+    EXPECT_LT(speed(s), 0.05);
   }
 }
 
@@ -363,133 +573,193 @@ TEST(Lateral, ASpunCarComesToRest) {
   // straight at 20 m/s, full lock held, no throttle, no brake: the car spins
   // and must then stop under drag and rolling resistance (it used to travel
   // backwards at 3.46 m/s for as long as the run lasted)
-  const VehicleParams& p = defaults();
-  VehicleState s = moving_state(p, 20.0);
-  const DriverInput in{p.steering_max, 0.0, 0.0};
-  double min_vx = 0.0;
-  for (int k = 0; k < 60000; ++k) {
-    step(p, s, in, kDt);
-    min_vx = std::min(min_vx, s.vx);
+  for (const VehicleParams* p : {&defaults(), &gotthard()}) {
+    VehicleState s = rolling_state(*p, Pose2{}, 20.0);
+    const DriverInput in{p->steering_max, 0.0, 0.0};
+    double min_vx = 0.0, max_yaw_turn = 0.0;
+    for (int k = 0; k < 60000; ++k) {
+      step(*p, s, in, kDt);
+      min_vx = std::min(min_vx, s.vx);
+      max_yaw_turn = std::max(max_yaw_turn, std::abs(s.r));
+    }
+    EXPECT_GT(max_yaw_turn, 1.0) << "the car did not turn hard: the test tests nothing";
+    EXPECT_LT(std::hypot(s.vx, s.vy), 0.05) << "vx " << s.vx << " vy " << s.vy;
+    EXPECT_LT(std::abs(s.r), 0.05);
   }
-  EXPECT_LT(min_vx, -1.0) << "the car did not spin: the test tests nothing";
-  EXPECT_LT(std::hypot(s.vx, s.vy), 0.05) << "vx " << s.vx << " vy " << s.vy;
-  EXPECT_LT(std::abs(s.r), 0.05);
-}
-
-TEST(Longitudinal, SpeedIsConservedWithoutForces) {
-  // no drive, brake, drag or rolling resistance: on a straight line nothing acts
-  VehicleParams p = defaults();
-  p.c_drag = 0.0;
-  p.cr0 = 0.0;
-  for (double v0 : {1.0, 2.5, 10.0}) {  // kinematic, blended, dynamic
-    VehicleState s = moving_state(p, v0);
-    for (int k = 0; k < 10000; ++k) step(p, s, DriverInput{}, kDt);
-    EXPECT_NEAR(s.vx, v0, 1e-12);
-    EXPECT_NEAR(s.x - moving_state(p, v0).x, v0 * 10.0, 1e-9);
-    EXPECT_EQ(s.vy, 0.0);
-  }
-}
-
-TEST(Longitudinal, KineticEnergyNeverGrowsInASlalomWithoutDrive) {
-  // tyre forces oppose the slip, so in the dynamic model their power is <= 0:
-  // E = m (vx^2 + vy^2) / 2 + Iz r^2 / 2 can only decrease (RK4 error aside)
-  VehicleParams p = defaults();
-  p.c_drag = 0.0;
-  p.cr0 = 0.0;
-  VehicleState s = moving_state(p, 15.0);
-  auto energy = [&](const VehicleState& st) {
-    return 0.5 * p.mass * (st.vx * st.vx + st.vy * st.vy) + 0.5 * p.inertia_z * st.r * st.r;
-  };
-  double e_prev = energy(s);
-  const double e0 = e_prev;
-  for (int k = 0; k < 5000; ++k) {
-    const double t = k * kDt;
-    step(p, s, DriverInput{0.15 * std::sin(2.0 * kPi * 0.5 * t), 0.0, 0.0}, kDt);
-    const double e = energy(s);
-    EXPECT_LE(e, e_prev + 1e-9 * e0) << "k = " << k;
-    e_prev = e;
-  }
-  EXPECT_LT(e_prev, e0);           // the slalom scrubbed some speed
-  EXPECT_GT(s.vx, 3.5);            // and stayed in the dynamic regime
 }
 
 // ---------------------------------------------------------------------------
 // lateral
 // ---------------------------------------------------------------------------
 
-
 TEST(Lateral, LowSpeedCorneringMatchesKinematicYawRate) {
   const VehicleParams& p = defaults();
   const double delta = 0.3;
   const VehicleState s = steady_corner(p, 1.0, delta, 20.0, initial_state(p, Pose2{}));
-  ASSERT_NEAR(s.vx, 1.0, 1e-3);
+  ASSERT_NEAR(s.vx, 1.0, 2e-2);
   ASSERT_NEAR(s.steering, delta, 1e-9);
   const double r_kin = s.vx * std::tan(delta) / (p.lf + p.lr);
   EXPECT_NEAR(s.r, r_kin, 0.01 * r_kin);
-  // the rear axle does not slip in the kinematic model
-  EXPECT_NEAR(base_velocity(p, s).y, 0.0, 1e-6);
 }
 
-TEST(Lateral, LinearRangeSteadyStateIsNeutralSteer) {
-  // single-track theory: r / delta = v / (L + K v^2), understeer gradient
-  // K = m (lr / Cf - lf / Cr) / L = 0 here (lf = lr, equal axle loads and tyres), so
-  // r = v delta / L like the kinematic model, although this runs fully dynamic (8 m/s)
+TEST(Lateral, SteadyStateCorneringIsTheLinearSingleTrackModel) {
+  // single-track theory: r = v delta / (L + K v^2), K = m (lr C_r - lf C_f) / (L C_f C_r)
+  // with the axle cornering stiffnesses C = 2 B C D L(Fz) Fz at the wheel
+  // loads there (static + downforce); within 1 % at 10-20 m/s, 0.5-2 deg, on
+  // gotthard (whose tyres stay linear enough there) and on the default car
+  // where its lateral acceleration stays below 0.4 g (its tyres are softer)
+  for (const VehicleParams* car : {&gotthard(), &defaults()}) {
+    const VehicleParams& p = *car;
+    const double L = p.lf + p.lr;
+    int checked = 0;
+    for (const double v : {10.0, 15.0, 20.0}) {
+      for (const double deg : {0.5, 1.0, 2.0}) {
+        const double delta = deg * kPi / 180.0;
+        const VehicleState s = steady_corner(p, v, delta, 15.0, rolling_state(p, Pose2{}, v));
+        if (car == &defaults() && std::abs(s.ay) > 0.4 * kGravity) continue;
+        const double down = p.c_down * s.vx * s.vx;
+        auto axle = [&](double static_share, double aero_share) {
+          const double fz = 0.5 * (p.mass * kGravity * static_share + aero_share * down);
+          return 2.0 * p.tyre_b * p.tyre_c * p.tyre_d * load_factor(p, fz) * fz;
+        };
+        const double cf = axle(p.lr / L, p.aero_balance_front), cr = axle(p.lf / L, 1.0 - p.aero_balance_front);
+        const double k_us = p.mass * (p.lr * cr - p.lf * cf) / (L * cf * cr);
+        const double r_theory = s.vx * delta / (L + k_us * s.vx * s.vx);
+        EXPECT_NEAR(s.r, r_theory, 0.01 * r_theory) << "v " << v << " deg " << deg;
+        ++checked;
+      }
+    }
+    EXPECT_GE(checked, 5);
+  }
+}
+
+TEST(Lateral, LeftAndRightAreMirrorImages) {
   const VehicleParams& p = defaults();
-  const double delta = 0.03;
-  const VehicleState s = steady_corner(p, 8.0, delta, 10.0, moving_state(p, 8.0));
-  ASSERT_NEAR(s.vx, 8.0, 1e-2);
-  const double r_theory = s.vx * delta / (p.lf + p.lr);
-  EXPECT_NEAR(s.r, r_theory, 0.01 * r_theory);
-  // and unlike the kinematic model, the rear axle now has a slip angle (it carries force)
-  EXPECT_LT(base_velocity(p, s).y, -1e-4);
+  auto run = [&](double sign) {
+    VehicleState s = initial_state(p, Pose2{});
+    for (int k = 0; k < 8000; ++k) {
+      const double t = k * kDt;
+      step(p, s, DriverInput{sign * 0.2 * std::sin(1.5 * t), t < 5.0 ? 0.8 : 0.0, t < 5.0 ? 0.0 : 0.6, sign * 100.0}, kDt);
+    }
+    return s;
+  };
+  const VehicleState a = run(1.0), b = run(-1.0);
+  EXPECT_GT(std::abs(a.y), 0.5);
+  EXPECT_NEAR(a.x, b.x, 1e-6);
+  EXPECT_NEAR(a.y, -b.y, 1e-6);
+  EXPECT_NEAR(a.yaw, -b.yaw, 1e-9);
+  EXPECT_NEAR(a.vy, -b.vy, 1e-9);
+  EXPECT_NEAR(a.r, -b.r, 1e-9);
+  EXPECT_NEAR(a.omega[kFrontLeft], b.omega[kFrontRight], 1e-9);
+  EXPECT_NEAR(a.omega[kRearRight], b.omega[kRearLeft], 1e-9);
+}
+
+TEST(Lateral, TorqueVectoringTurnsTheCar) {
+  // a yaw moment request on a straight: the right wheels drive harder, the car
+  // turns left (and right for a negative one), the drive split unchanged on average
+  const VehicleParams& p = defaults();
+  VehicleState s = rolling_state(p, Pose2{}, 10.0);
+  for (int k = 0; k < 2000; ++k) step(p, s, DriverInput{0.0, 0.2, 0.0, 300.0}, kDt);
+  EXPECT_GT(s.r, 0.05);
+  EXPECT_GT(s.y, 0.1);
+  VehicleState n = rolling_state(p, Pose2{}, 10.0);
+  for (int k = 0; k < 2000; ++k) step(p, n, DriverInput{0.0, 0.2, 0.0, 0.0}, kDt);
+  EXPECT_NEAR(n.r, 0.0, 1e-12);
+  EXPECT_NEAR(s.vx, n.vx, 0.05 * n.vx);
+}
+
+TEST(Lateral, ResultsConvergeAsTheStepShrinks) {
+  // a launch into a slalom and a braking zone at 4, 2, 1, 0.5 and 0.25 ms:
+  // the difference to the finest halves at least with each halving of the step
+  const VehicleParams& p = defaults();
+  auto run = [&](double dt) {
+    VehicleState s = rolling_state(p, Pose2{}, 5.0);
+    const int n = static_cast<int>(std::lround(6.0 / dt));
+    for (int k = 0; k < n; ++k) {
+      const double t = k * dt;
+      step(p, s, DriverInput{0.15 * std::sin(2.0 * t), t < 4.0 ? 0.7 : 0.0, t < 4.0 ? 0.0 : 0.5}, dt);
+    }
+    return s;
+  };
+  const VehicleState fine = run(0.125e-3);
+  double prev = 1e9;
+  for (const double dt : {4e-3, 2e-3, 1e-3, 0.5e-3, 0.25e-3}) {
+    const VehicleState s = run(dt);
+    const double err = std::hypot(s.x - fine.x, s.y - fine.y);
+    EXPECT_LT(err, 0.75 * prev + 1e-6) << "dt " << dt;
+    prev = err;
+  }
+  EXPECT_LT(prev, 0.01);
 }
 
 TEST(Lateral, SkidpadMaximumLateralAccelerationIsPlausible) {
   // hold a skidpad circle (R = 9.125 m, FS skidpad centreline) with pure pursuit while
   // the target speed ramps up; the largest lateral acceleration held on the circle
-  // (0.5 s average) must be physically plausible: 1.2 g .. 2.5 g, and not above the
-  // friction bound D (g + c_down v^2 / m) of the whole car at that speed
-  const VehicleParams& p = defaults();
-  const double R = 9.125;
-  const Vec2 centre{0.0, R};
-  const double L = p.lf + p.lr;
-  VehicleState s = initial_state(p, Pose2{-p.lr, 0.0, 0.0});  // CG on the circle, heading +x, turning left
-
-  const int window = 500;
-  std::vector<double> ay_hist;
-  double best_ay = 0.0, best_v = 0.0;
-  for (int k = 0; k < 60000; ++k) {
-    const double t = k * kDt;
-    const double v_target = std::min(2.0 + 0.25 * t, 20.0);
-    // pure pursuit from the rear axle to a point on the circle 4 m ahead
-    const Pose2 base = base_pose(p, s);
-    const Vec2 rel = base.position() - centre;
-    const double theta = std::atan2(rel.y, rel.x) + 4.0 / R;
-    const Vec2 target = centre + R * unit_from_angle(theta);
-    const Vec2 local = base.inverse_transform(target);
-    const double ld2 = squared_norm(local);
-    const double steer = std::atan(2.0 * L * local.y / ld2);
-    const double thr = std::clamp(0.1 + 0.5 * (v_target - s.vx), 0.0, 1.0);
-    step(p, s, DriverInput{steer, thr, 0.0}, kDt);
-
-    ay_hist.push_back(body_acceleration(s).y);
-    const double err = distance(Vec2{s.x, s.y}, centre) - R;
-    if (static_cast<int>(ay_hist.size()) >= window && t > 3.0 && std::abs(err) < 0.3) {
-      double mean = 0.0;
-      for (std::size_t i = ay_hist.size() - window; i < ay_hist.size(); ++i) mean += ay_hist[i];
-      mean /= window;
-      if (mean > best_ay) {
-        best_ay = mean;
-        best_v = speed(s);
+  // (0.5 s average) must be that of an FS car, 1.5 g .. 2.2 g for the default car,
+  // and not above the friction bound D (g + c_down v^2 / m) of the whole car at that speed
+  for (const VehicleParams* car : {&defaults(), &gotthard()}) {
+    const VehicleParams& p = *car;
+    const double R = 9.125;
+    const Vec2 centre{0.0, R};
+    const double L = p.lf + p.lr;
+    VehicleState s = initial_state(p, Pose2{-p.lr, 0.0, 0.0});  // CG on the circle, heading +x, turning left
+    const int window = 500;
+    std::vector<double> ay_hist;
+    double best_ay = 0.0, best_v = 0.0;
+    for (int k = 0; k < 60000; ++k) {
+      const double t = k * kDt;
+      const double v_target = std::min(2.0 + 0.25 * t, 20.0);
+      // pure pursuit from the rear axle to a point on the circle 4 m ahead
+      const Pose2 base = base_pose(p, s);
+      const Vec2 rel = base.position() - centre;
+      const double theta = std::atan2(rel.y, rel.x) + 4.0 / R;
+      const Vec2 target = centre + R * unit_from_angle(theta);
+      const Vec2 local = base.inverse_transform(target);
+      const double steer = std::atan(2.0 * L * local.y / squared_norm(local));
+      const double thr = std::clamp(0.1 + 0.5 * (v_target - s.vx), 0.0, 1.0);
+      step(p, s, DriverInput{steer, thr, 0.0}, kDt);
+      ay_hist.push_back(body_acceleration(s).y);
+      const double err = distance(Vec2{s.x, s.y}, centre) - R;
+      if (static_cast<int>(ay_hist.size()) >= window && t > 3.0 && std::abs(err) < 0.3) {
+        double mean = 0.0;
+        for (std::size_t i = ay_hist.size() - window; i < ay_hist.size(); ++i) mean += ay_hist[i];
+        mean /= window;
+        if (mean > best_ay) {
+          best_ay = mean;
+          best_v = speed(s);
+        }
       }
     }
+    const double g = kGravity;
+    EXPECT_GT(best_ay, (car == &defaults() ? 1.5 : 1.2) * g);
+    EXPECT_LT(best_ay, (car == &defaults() ? 2.2 : 2.5) * g);
+    EXPECT_LE(best_ay, p.tyre_d * (g + p.c_down * best_v * best_v / p.mass) * 1.01);
+    std::printf("skidpad: max steady lateral acceleration %.2f m/s^2 = %.2f g at %.2f m/s\n", best_ay, best_ay / g,
+                best_v);
   }
-  const double g = kGravity;
-  EXPECT_GT(best_ay, 1.2 * g);
-  EXPECT_LT(best_ay, 2.5 * g);
-  EXPECT_LE(best_ay, p.tyre_d * (g + p.c_down * best_v * best_v / p.mass) * 1.01);
-  std::printf("skidpad: max steady lateral acceleration %.2f m/s^2 = %.2f g at %.2f m/s\n", best_ay,
-              best_ay / g, best_v);
+}
+
+TEST(Stability, AtTheStepLimitAHardManoeuvreStaysSane) {
+  // stable_step_limit: at the limit a hard manoeuvre (full throttle and full
+  // brake through a slalom at full lock amplitude) stays finite and close to
+  // the same manoeuvre at a fine step
+  for (const VehicleParams* p : {&defaults(), &gotthard()}) {
+    auto run = [&](double dt) {
+      VehicleState s = rolling_state(*p, Pose2{}, 2.0);
+      const int n = static_cast<int>(std::lround(8.0 / dt));
+      for (int k = 0; k < n && is_finite(s); ++k) {
+        const double t = k * dt;
+        step(*p, s, DriverInput{0.4 * std::sin(2.0 * t), t < 5.0 ? 1.0 : 0.0, t < 5.0 ? 0.0 : 1.0}, dt);
+      }
+      return s;
+    };
+    const double limit = stable_step_limit(*p);
+    ASSERT_GT(limit, 1e-3);
+    const VehicleState ok = run(limit);
+    ASSERT_TRUE(is_finite(ok));
+    const VehicleState fine = run(0.25e-3);
+    EXPECT_LT(std::hypot(ok.x - fine.x, ok.y - fine.y), 0.05 * std::hypot(fine.x, fine.y));
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -644,13 +914,17 @@ TEST(Accessors, BasePoseWheelsFootprintAndWheelSpeeds) {
   EXPECT_EQ(f.corners()[2].x, f.x_max);
   EXPECT_EQ(f.corners()[2].y, f.y_max);
 
-  // wheel speeds: v / R on a straight; in a turn the outer wheels turn faster
-  s.vx = 10.0;
+  // wheel speeds: the wheels' spin, v / R rolling straight, 0 slip there
+  s = rolling_state(p, pose, 10.0);
   for (double omega : wheel_speeds(p, s)) EXPECT_NEAR(omega, 10.0 / p.wheel_radius, 1e-12);
+  for (double kappa : slip_ratios(p, s)) EXPECT_NEAR(kappa, 0.0, 1e-12);
   s.r = 0.5;
-  const auto ws = wheel_speeds(p, s);
-  EXPECT_NEAR(ws[kRearRight] - ws[kRearLeft], 0.5 * p.track_rear / p.wheel_radius, 1e-12);
   EXPECT_NEAR(base_velocity(p, s).y, -p.lr * 0.5, 1e-12);
+  // in a turn the outer wheels cover more ground: at the same spin the inner one slips forward
+  const auto kappa = slip_ratios(p, s);
+  const double v_left = 10.0 - 0.5 * 0.5 * p.track_rear, v_right = 10.0 + 0.5 * 0.5 * p.track_rear;
+  EXPECT_NEAR(kappa[kRearLeft], (10.0 - v_left) / v_left, 1e-12);
+  EXPECT_NEAR(kappa[kRearRight], (10.0 - v_right) / v_right, 1e-12);
 }
 
 TEST(Accessors, AccelerationMatchesTheVelocityChange) {
