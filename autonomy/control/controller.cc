@@ -147,6 +147,7 @@ ControlOutput Controller::update(const ControlInput& in) {
 
   // yaw-rate damping: yawing left faster than the path asks -> steer right
   delta -= params_.k_d_yaw * (in.yaw_rate - r_traj);
+  out.yaw_moment = -params_.k_tv_yaw * (in.yaw_rate - r_traj);
   out.steering_angle = std::clamp(delta, -car.max_steering_angle, car.max_steering_angle);
 
   // the reference speed, read speed_preview_time ahead for the actuators' lag

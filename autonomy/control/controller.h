@@ -85,6 +85,11 @@ struct ControlParams {
   // gain is v / L = 9.8 1/s, so 0.05 s closes a damping loop of ~0.5: damps
   // the yaw transient without fighting the steering
   double k_d_yaw = 0.05;
+  // the same damping by torque vectoring (a car with a motor per driven
+  // wheel): yaw moment M = -k_tv_yaw (r_meas - r_traj). 0 (off) by default:
+  // the paper's car damps with the steering; 300 N m s asks 60 N m (a 100 N
+  // left/right force difference on a 1.2 m track) for a 0.2 rad/s error
+  double k_tv_yaw = 0.0;
   LongitudinalParams longitudinal;
   // the projection searches +-projection_window of arc length around the last
   // cycle's s (advanced by v dt), so a track that passes near itself cannot
@@ -101,6 +106,7 @@ struct ControlParams {
     v.section(PADDOCK_PARAM(pure_pursuit), "the pure pursuit law");
     v.section(PADDOCK_PARAM(combined), "the curvature-weighted combination of pure pursuit and Stanley");
     v(PADDOCK_PARAM(k_d_yaw), {"s", params::in(0.0, 10.0), "yaw-rate damping gain"});
+    v(PADDOCK_PARAM(k_tv_yaw), {"N m s", params::in(0.0, 1e4), "yaw-rate damping by torque vectoring (0: off)"});
     v.section(PADDOCK_PARAM(longitudinal), "the speed loop");
     v(PADDOCK_PARAM(projection_window), {"m", params::in(0.1, 100.0), "arc-length window of the path projection"});
     v(PADDOCK_PARAM(relocalize_distance), {"m", params::above(0.0),
@@ -140,6 +146,7 @@ struct ControlOutput {
   double steering_angle = 0.0;  // front wheel angle (rad, > 0 left), within the limit
   double throttle = 0.0;        // [0, 1]
   double brake = 1.0;           // [0, 1]
+  double yaw_moment = 0.0;      // torque vectoring request (N m, > 0 counter-clockwise)
   Status status = Status::Ok;
   const char* reason = "";      // what went wrong when status != Ok (a static string)
   Diagnostics diagnostics;

@@ -118,8 +118,9 @@ using SensorMessage = std::variant<StateEstimate, ResSignal, ConeDetections, Imu
 struct ActuatorCommand {
   TimeNs stamp = 0;
   double steering_angle = 0.0;  // road-wheel angle request (rad, > 0 left)
-  double throttle = 0.0;        // fraction of the maximum drive force [0, 1]
-  double brake = 1.0;           // fraction of the maximum brake force [0, 1]
+  double throttle = 0.0;        // fraction of the motor torque limit [0, 1]
+  double brake = 1.0;           // fraction of the maximum brake torque [0, 1]
+  double yaw_moment = 0.0;      // torque vectoring: a left/right drive torque difference (N m, > 0 counter-clockwise)
   AsState as_state = AsState::Off;
 };
 

@@ -371,6 +371,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   } else {
     cmd.steering_angle = out.steering_angle;
     cmd.throttle = out.throttle;
+    cmd.yaw_moment = out.yaw_moment;
     cmd.brake = out.brake;
   }
   hal.send(cmd);

@@ -58,7 +58,7 @@ void control(const SimModel& model, SimState& s, const Pose2& base) {
   s.stack.tick(s.now, s.hal);
   if (s.hal.command()) {
     const hal::ActuatorCommand& c = *s.hal.command();
-    s.input = vehicle::DriverInput{c.steering_angle, c.throttle, c.brake};
+    s.input = vehicle::DriverInput{c.steering_angle, c.throttle, c.brake, c.yaw_moment};
     s.as_state = c.as_state;
   }
   ++s.control_cycles;

@@ -208,6 +208,13 @@ TEST(Controller, YawRateDampingOpposesExcessYaw) {
   in.yaw_rate += 0.5;
   const double excess = Controller().update(in).steering_angle;
   EXPECT_NEAR(excess - matched, -ControlParams{}.k_d_yaw * 0.5, 1e-12);
+  // torque vectoring is off by default; on, it asks a yaw moment against the excess
+  EXPECT_EQ(Controller().update(in).yaw_moment, 0.0);
+  ControlParams tv;
+  tv.k_tv_yaw = 300.0;
+  EXPECT_NEAR(Controller(tv).update(in).yaw_moment, -300.0 * 0.5, 1e-9);
+  in.yaw_rate = 8.0 / 15.0;
+  EXPECT_NEAR(Controller(tv).update(in).yaw_moment, 0.0, 1e-9);
 }
 
 TEST(Controller, EmptyOrMissingTrajectoryIsASafeStop) {
