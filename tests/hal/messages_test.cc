@@ -164,6 +164,7 @@ Message actuator_command() {
                                    {"steering_angle", "steering actuator controller on CAN"},
                                    {"throttle", "inverters via the VCU: drive torque request"},
                                    {"brake", "brake actuator (service brake) controller on CAN"},
+                                   {"yaw_moment", "inverters via the VCU: the left/right torque difference (torque vectoring)"},
                                    {"as_state", "VCU: the AS state machine, ASSIs and EBS"}});
 }
 
