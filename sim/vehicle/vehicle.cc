@@ -238,6 +238,25 @@ double motor_torques(const Model& m, const X& s, std::array<double, 4>& torque, 
   return p_drive * k_drive * m.inv_eta + p_regen * k_regen * m.eta;
 }
 
+// the force of wheel i's tyre (wheel frame) at load fz, its contact moving at
+// (vcx, vcy) and slipping at v_slip = omega r - vcx: the deflections' force,
+// and below kLowSpeed the damper on the slip velocities. The damper adds to
+// the spring up to the friction the wheel has: it still opposes the slip
+// (dissipates), never beyond what the road takes
+inline TyreForce contact_force(const Model& m, const X& s, std::size_t i, double fz, double vcx, double v_slip,
+                               double vcy) {
+  const VehicleParams& p = *m.p;
+  TyreForce f = tyre_force(p, s.ux[i] * m.inv_sigma_x, std::atan(s.uy[i] * m.inv_sigma_y), fz);
+  const double low = 1.0 - std::abs(vcx) * (1.0 / kLowSpeed);
+  if (low > 0.0) {
+    const double k = low * std::min(1.0, fz * m.inv_fz_static[i]);
+    const double mu = load_factor(p, fz) * fz;
+    f.fx = std::clamp(f.fx + k * m.c_x[i] * v_slip, -p.tyre_dx * mu, p.tyre_dx * mu);
+    f.fy = std::clamp(f.fy - k * m.c_y[i] * vcy, -p.tyre_d * mu, p.tyre_d * mu);
+  }
+  return f;
+}
+
 // the state derivative (the wheels' spin with the friction decided in step())
 Deriv derivative(const Model& m, const X& s) {
   const VehicleParams& p = *m.p;
@@ -273,17 +292,8 @@ Deriv derivative(const Model& m, const X& s) {
     const double vcx = c * vbx + sn * vby;
     const double vcy = c * vby - sn * s.vx;
     const double fz = std::max(0.0, m.fz_static[i] + m.aero_share[i] * f_down + (front ? -transfer : transfer));
-    TyreForce f = tyre_force(p, s.ux[i] * m.inv_sigma_x, std::atan(s.uy[i] * m.inv_sigma_y), fz);
     const double v_slip = s.w[i] * m.radius - vcx;
-    const double low = 1.0 - std::abs(vcx) * (1.0 / kLowSpeed);
-    if (low > 0.0) {
-      // the damper adds to the spring up to the friction the wheel has: it
-      // still opposes the slip (dissipates), never beyond what the road takes
-      const double k = low * std::min(1.0, fz * m.inv_fz_static[i]);
-      const double mu = load_factor(p, fz) * fz;
-      f.fx = std::clamp(f.fx + k * m.c_x[i] * v_slip, -p.tyre_dx * mu, p.tyre_dx * mu);
-      f.fy = std::clamp(f.fy - k * m.c_y[i] * vcy, -p.tyre_d * mu, p.tyre_d * mu);
-    }
+    const TyreForce f = contact_force(m, s, i, fz, vcx, v_slip, vcy);
     // the deflections relax towards the slips
     d.ux[i] = v_slip - std::abs(vcx) * s.ux[i] * m.inv_sigma_x;
     d.uy[i] = vcy - std::abs(vcx) * s.uy[i] * m.inv_sigma_y;
