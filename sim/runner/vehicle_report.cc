@@ -117,7 +117,7 @@ BrakingRun stop_from(TestCar& car, double v0, double pedal, double max_distance)
   }
   r.distance = d.path();
   r.time = d.t();
-  r.mean_deceleration = r.stopped ? v0 / d.t() : 0.0;
+  r.mean_deceleration = r.stopped ? v0 * v0 / (2.0 * d.path()) : 0.0;
   return r;
 }
 

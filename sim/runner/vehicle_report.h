@@ -37,7 +37,7 @@ struct BrakingRun {
   bool stopped = false;            // false: still rolling after 60 s
   double distance = 0.0;           // m, travelled by the CG until at rest (< 0.05 m/s)
   double time = 0.0;               // s
-  double mean_deceleration = 0.0;  // m/s^2, initial speed / time
+  double mean_deceleration = 0.0;  // m/s^2, v0^2 / (2 distance): the constant deceleration that stops as short
 };
 
 // the fastest steady lap of the skidpad circle
