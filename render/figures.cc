@@ -692,4 +692,67 @@ Figure draw_heatmap(const HeatmapData& d, const FigureStyle& style) {
   return page.finish({f});
 }
 
+// ---- the line chart ----
+
+Figure draw_line_chart(const LineChartData& d, const FigureStyle& style) {
+  Page page(style);
+  Range xr, yr;
+  if (d.include_zero) yr.include(0.0);
+  for (const LineSeries& s : d.series) {
+    if (s.x.size() != s.y.size()) {
+      throw RenderError("draw_line_chart: series \"" + s.label + "\" has " + std::to_string(s.x.size()) + " x but " +
+                        std::to_string(s.y.size()) + " y values (give one y per x)");
+    }
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      if (!std::isfinite(s.x[i]) || !std::isfinite(s.y[i])) continue;
+      xr.include(s.x[i]);
+      yr.include(s.y[i]);
+    }
+  }
+  const Range xp = xr.padded(0.04, 1e-6), yp = yr.padded(0.06, 1e-6);
+  Axes ax;
+  ax.x.label = d.x_label;
+  ax.y.label = d.y_label;
+  fit_axes(page, ax, d.title, 0.0, nullptr,
+           [&](AxesFrame& f) {
+             f.x_min = xp.lo, f.x_max = xp.hi, f.y_min = yp.lo, f.y_max = yp.hi;
+             widen(f.x_min, f.x_max);
+             widen(f.y_min, f.y_max);
+           },
+           false);
+  const AxesFrame& f = ax.frame;
+  Canvas& c = page.canvas();
+  ax.draw_grid(page);
+  c.set_clip(f.plot);
+  std::vector<Vec2> avoid;
+  std::vector<LegendEntry> legend;
+  for (const LineSeries& s : d.series) {
+    std::vector<Vec2> pts;
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      const bool ok = std::isfinite(s.x[i]) && std::isfinite(s.y[i]);
+      pts.push_back(ok ? f.to_pixel({s.x[i], s.y[i]}) : Vec2{std::nan(""), std::nan("")});
+    }
+    Stroke st;
+    st.width = page.px(1.6);
+    st.join = Join::Round;
+    st.cap = Cap::Round;
+    c.stroke(pts, st, s.color);
+    for (const Vec2& q : pts) {
+      if (!std::isfinite(q.x)) continue;
+      c.marker(q, s.marker, page.px(5.5), s.color, kBlack, 0.0);
+      avoid.push_back(q);
+    }
+    // the segments between points too, so the legend keeps off the lines
+    for (std::size_t i = 0; i + 1 < pts.size(); ++i) {
+      for (double t : {0.25, 0.5, 0.75}) avoid.push_back(pts[i] + (pts[i + 1] - pts[i]) * t);
+    }
+    if (!s.label.empty()) legend.push_back({LegendEntry::Kind::Line, s.label, s.color, {}, 1.6});
+  }
+  c.reset_clip();
+  ax.draw_frame(page);
+  draw_title(page, d.title, f.plot.left, f.plot.right, page.px(kTheme.pad));
+  if (!legend.empty()) page.boxes()["legend"] = draw_legend(page, f, legend, LegendPlace::Best, avoid);
+  return page.finish({f});
+}
+
 }  // namespace paddock::render

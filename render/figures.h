@@ -163,6 +163,27 @@ struct HeatmapData {
 // value v: [v - 0.5, v + 0.5]); values.size() != x.size() * y.size() is a RenderError
 Figure draw_heatmap(const HeatmapData& data, const FigureStyle& style);
 
+// ---- the line chart (the vehicle report's g-g-v envelope) ----
+
+struct LineSeries {
+  std::string label;            // in the legend; empty: not listed
+  std::vector<double> x, y;     // one y per x; a non-finite point breaks the line and has no marker
+  Rgba color{31, 119, 180, 255};
+  Marker marker = Marker::Circle;  // drawn at every point
+};
+
+struct LineChartData {
+  std::string title, x_label, y_label;
+  std::vector<LineSeries> series;
+  bool include_zero = true;     // the y range reaches down (or up) to 0
+};
+
+// each series as a line with a marker at each point over a grid with nice
+// ticks (the data's range, padded), the legend in the plot's emptiest corner;
+// x.size() != y.size() in a series is a RenderError. Boxes: "title",
+// "legend", "x_label", "y_label"
+Figure draw_line_chart(const LineChartData& data, const FigureStyle& style);
+
 // ---- colour maps and PNG ----
 
 // viridis at t in [0, 1] (clamped): a perceptually uniform map, dark blue to yellow

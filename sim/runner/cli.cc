@@ -1,9 +1,11 @@
 #include "sim/runner/cli.h"
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
+#include "autonomy/common/format.h"
 #include "render/figures.h"
 #include "sim/runner/files.h"
 #include "sim/runner/plots.h"
@@ -12,6 +14,7 @@
 #include "sim/runner/scenario.h"
 #include "sim/runner/schema.h"
 #include "sim/runner/simulation.h"
+#include "sim/runner/vehicle_report.h"
 #include "sim/world/track.h"
 
 namespace paddock::runner {
@@ -35,6 +38,11 @@ const char* kUsage =
     "      Table I of the paper: the scenario with each lateral controller, as Markdown\n"
     "  paddock report smoothing TRACK.csv\n"
     "      Table II of the paper: four smoothings of the track's planned centreline\n"
+    "  paddock report vehicle [CAR.ini] [--out DIR] [--chart-size WxH] [--dpi D]\n"
+    "      the car's figures from experiments on the simulated car: 0-75 m, top speed,\n"
+    "      braking from 100 km/h, the skidpad limit and the g-g-v envelope; writes\n"
+    "      DIR/vehicle_report.json and DIR/ggv.png (CAR.ini defaults to\n"
+    "      scenarios/vehicles/default.ini, DIR to runs/vehicle_<car name>)\n"
     "  paddock keys\n"
     "      every scenario key (section = struct path) with its default, unit, range and\n"
     "      meaning, as the README's Markdown table\n"
@@ -124,8 +132,7 @@ int cmd_run(const std::vector<std::string>& args) {
       img.rgba.resize(static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height) * 4, 255);
       for (std::size_t i = 0; i < s.rgb.size() / 3; ++i)
         for (std::size_t c = 0; c < 3; ++c) img.rgba[4 * i + c] = s.rgb[3 * i + c];
-      const std::vector<std::uint8_t> png = render::encode_png(img);
-      write_file_atomic(out_dir + "/camera.png", std::string(png.begin(), png.end()));
+      write_png(out_dir + "/camera.png", img);
     }
   }
 
@@ -141,7 +148,39 @@ int cmd_run(const std::vector<std::string>& args) {
   return failed.empty() ? 0 : 3;
 }
 
+// report vehicle [CAR.ini] [--out DIR] [--chart-size WxH] [--dpi D]
+int cmd_report_vehicle(const std::vector<std::string>& args) {
+  std::string car, out_dir;
+  PlotOptions options;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a != "--map-size" && plot_option(args, i, options)) continue;
+    if (a == "--out") {
+      if (i + 1 >= args.size()) throw UserError("--out needs a value");
+      out_dir = args[++i];
+    } else if (!a.empty() && a[0] == '-') {
+      throw UserError("report vehicle: unknown option " + a + "\n" + kUsage);
+    } else if (car.empty()) {
+      car = a;
+    } else {
+      throw UserError("report vehicle: more than one vehicle file given: " + car + " and " + a);
+    }
+  }
+  if (car.empty()) car = "scenarios/vehicles/default.ini";
+  const vehicle::VehicleParams params = load_vehicle_file(car);
+  // like run's runs/<scenario name>
+  if (out_dir.empty()) out_dir = "runs/vehicle_" + std::filesystem::path(car).stem().string();
+  const auto start = std::chrono::steady_clock::now();
+  const VehicleReport report = vehicle_report(params, car);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::vector<std::string> files = write_vehicle_report(report, out_dir, options);
+  std::cout << vehicle_report_text(report) << "  output      " << files[0] << "\n  figure      " << files[1] << "\n"
+            << "  speed       " << fixed(report.simulated_time, 1) << " s simulated in " << fixed(wall, 3) << " s\n";
+  return 0;
+}
+
 int cmd_report(const std::vector<std::string>& args) {
+  if (!args.empty() && args[0] == "vehicle") return cmd_report_vehicle({args.begin() + 1, args.end()});
   if (args.size() >= 2 && args[0] == "smoothing" && args.size() == 2) {
     std::cout << report_smoothing(args[1]);
     return 0;
@@ -155,7 +194,7 @@ int cmd_report(const std::vector<std::string>& args) {
     std::cout << report_controllers(args[1], overrides);
     return 0;
   }
-  throw UserError(std::string("report needs 'controllers SCENARIO' or 'smoothing TRACK'\n") + kUsage);
+  throw UserError(std::string("report needs 'controllers SCENARIO', 'smoothing TRACK' or 'vehicle [CAR]'\n") + kUsage);
 }
 
 int cmd_plot(const std::vector<std::string>& args) {

@@ -98,11 +98,6 @@ void add_plan_layers(const std::string& path, render::TrackMapData& map) {
   }
 }
 
-void write_png(const std::string& path, const render::Image& image) {
-  const std::vector<std::uint8_t> png = render::encode_png(image);
-  write_file_atomic(path, std::string(png.begin(), png.end()));
-}
-
 ConeColor color_of_tag(const std::string& tag) {
   for (ConeColor k : {ConeColor::Blue, ConeColor::Yellow, ConeColor::SmallOrange, ConeColor::BigOrange})
     if (tag == cone_tag(k)) return k;
@@ -168,6 +163,11 @@ std::vector<std::string> plot_perception(const std::string& dir, const render::F
 }
 
 }  // namespace
+
+void write_png(const std::string& path, const render::Image& image) {
+  const std::vector<std::uint8_t> png = render::encode_png(image);
+  write_file_atomic(path, std::string(png.begin(), png.end()));
+}
 
 std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& source) {
   std::vector<LogRow> rows;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "render/figures.h"
 #include "sim/runner/simulation.h"
 
 namespace paddock::runner {
@@ -22,6 +23,9 @@ struct PlotOptions {
 // atomically) and returns their paths; throws UserError naming the file and
 // line of anything it cannot read
 std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& options);
+
+// the image as a PNG file at path, written atomically
+void write_png(const std::string& path, const render::Image& image);
 
 // log.csv as written by log_csv(); throws UserError "source:line: ..."
 std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& source);

@@ -1,8 +1,10 @@
 #include "sim/runner/scenario.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <set>
 #include <sstream>
@@ -123,10 +125,13 @@ void resolve_track(Scenario& s, const IniEntry& e) {
   s.scenario.track = fs::absolute(s.track_path).lexically_normal().string();
 }
 
-// sets every entry's key; unknown sections and keys, and required keys left
-// unset, are errors
-void apply_entries(Scenario& s, const std::vector<IniEntry>& entries, const std::string& path) {
-  std::vector<Key> keys = scenario_keys(s);
+using Given = std::set<std::pair<std::string, std::string>>;
+
+// sets each entry's key among `keys` (then calls after(key, entry)); unknown
+// sections and keys are errors naming what was expected; returns the
+// (section, key) pairs given
+Given set_keys(std::vector<Key>& keys, const std::vector<IniEntry>& entries,
+               const std::function<void(const Key&, const IniEntry&)>& after) {
   std::map<std::pair<std::string, std::string>, Key*> index;
   std::map<std::string, std::string> names_in;  // section -> its keys, for messages
   for (Key& k : keys) {
@@ -134,12 +139,12 @@ void apply_entries(Scenario& s, const std::vector<IniEntry>& entries, const std:
     std::string& names = names_in[k.section];
     names += (names.empty() ? "" : ", ") + k.name;
   }
-  std::set<std::pair<std::string, std::string>> given;
+  Given given;
   for (const IniEntry& e : entries) {
     const auto it = index.find({e.section, e.key});
     if (it != index.end()) {
       it->second->set(e);
-      if (it->second->path() == "scenario.track") resolve_track(s, e);
+      if (after) after(*it->second, e);
       given.insert({e.section, e.key});
       continue;
     }
@@ -153,12 +158,27 @@ void apply_entries(Scenario& s, const std::vector<IniEntry>& entries, const std:
     throw UserError(e.where() + ": unknown section [" + e.section + "]" +
                     (hint.empty() ? "; expected one of: " + sections : hint));
   }
+  return given;
+}
+
+// every required key among `keys` must have been given
+void require_given(const std::vector<Key>& keys, const Given& given, const std::string& path, const std::string& hint) {
   for (const Key& k : keys) {
     if (k.required && !given.count({k.section, k.name})) {
       throw UserError(path + ": [" + k.section + "] " + k.name + " is not set" + (k.unit.empty() ? "" : " (" + k.unit + ")") +
-                      (k.section == "vehicle" ? "; include a vehicle file, e.g. include = vehicles/default.ini" : ""));
+                      (k.section == "vehicle" ? hint : ""));
     }
   }
+}
+
+// sets every entry's key; unknown sections and keys, and required keys left
+// unset, are errors
+void apply_entries(Scenario& s, const std::vector<IniEntry>& entries, const std::string& path) {
+  std::vector<Key> keys = scenario_keys(s);
+  const Given given = set_keys(keys, entries, [&s](const Key& k, const IniEntry& e) {
+    if (k.path() == "scenario.track") resolve_track(s, e);
+  });
+  require_given(keys, given, path, "; include a vehicle file, e.g. include = vehicles/default.ini");
   if (s.track_path.empty()) throw UserError(path + ": [scenario] track is not set; expected the track's CSV file");
 }
 
@@ -203,6 +223,19 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
   s.source = path;
   s.name = std::filesystem::path(path).stem().string();
   return s;
+}
+
+vehicle::VehicleParams load_vehicle_file(const std::string& path) {
+  const std::vector<IniEntry> entries = read_ini_file(path);
+  // the [vehicle] keys of a scenario, and no others
+  Scenario s;
+  std::vector<Key> keys = scenario_keys(s);
+  keys.erase(std::remove_if(keys.begin(), keys.end(), [](const Key& k) { return k.section != "vehicle"; }), keys.end());
+  require_given(keys, set_keys(keys, entries, nullptr), path, "");
+  if (const std::string why = params::validate(s.vehicle); !why.empty()) throw UserError(path + ": " + as_section_key("vehicle." + why));
+  // the physics step of a default scenario (1 kHz) must integrate this car stably
+  if (const std::string why = s.check(); !why.empty()) throw UserError(path + ": [vehicle] at the default physics rate: " + why);
+  return s.vehicle;
 }
 
 std::string resolved_ini(const Scenario& scenario) {

@@ -167,6 +167,14 @@ struct Scenario {
 // every key and value; throws UserError "file:line: ..." on any problem
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides = {});
 
+// a vehicle parameter file (scenarios/vehicles/default.ini's format: one
+// [vehicle] section, includes allowed) read with the scenario's keys and
+// checks: an unknown section or key, a bad number, a value out of range or a
+// key left unset throws UserError "file:line: ..." ("file: ..." when no line
+// is to blame), as in a scenario; so does a car the default physics step
+// (1 kHz) cannot integrate stably
+vehicle::VehicleParams load_vehicle_file(const std::string& path);
+
 
 // the resolved scenario as INI text: every key, defaults included, in SI units,
 // loadable again to the same Scenario

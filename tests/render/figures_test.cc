@@ -660,5 +660,51 @@ TEST(Heatmap, DegenerateGrids) {
   EXPECT_THROW(draw_heatmap(d, style(800, 600)), RenderError);
 }
 
+// ---- the line chart ----
+
+TEST(LineChart, SeriesPassThroughTheirPointsInTheirColours) {
+  LineChartData d;
+  d.title = "g-g-v envelope";
+  d.x_label = "speed [m/s]";
+  d.y_label = "acceleration [g]";
+  const Rgba blue{31, 119, 180, 255}, red{214, 39, 40, 255};
+  d.series = {{"max lateral", {5, 10, 15, 20, 25}, {0.9, 1.7, 1.9, 2.2, 2.5}, blue, Marker::Circle},
+              {"max braking", {5, 10, 15, 20, 25}, {1.2, 1.3, 1.4, 1.5, 1.6}, red, Marker::Square}};
+  const Figure fig = draw_line_chart(d, style(1200, 900));
+  const Image img = round_trip(fig, "line_chart");
+  EXPECT_EQ(img.width, 1200);
+  EXPECT_EQ(img.height, 900);
+  const AxesFrame& ax = fig.axes.at(0);
+  // the range covers the data and reaches down to 0
+  EXPECT_LE(ax.x_min, 5.0);
+  EXPECT_GE(ax.x_max, 25.0);
+  EXPECT_LE(ax.y_min, 0.0);
+  EXPECT_GE(ax.y_max, 2.5);
+  for (const LineSeries& s : d.series) {
+    for (std::size_t i = 0; i < s.x.size(); ++i) {
+      // the marker at the point, and the line half way to the next one
+      EXPECT_TRUE(same(at(img, ax, {s.x[i], s.y[i]}), s.color, 2)) << s.label << " " << i;
+      if (i + 1 == s.x.size()) continue;
+      const Vec2 mid{0.5 * (s.x[i] + s.x[i + 1]), 0.5 * (s.y[i] + s.y[i + 1])};
+      EXPECT_TRUE(same(at(img, ax, mid), s.color, 2)) << s.label << " " << i << ": " << str(at(img, ax, mid));
+    }
+  }
+  // nothing where no series is (white, or a light grid line)
+  const Rgba empty = at(img, ax, {20.0, 0.5});
+  EXPECT_TRUE(empty.r == empty.g && empty.g == empty.b && empty.r > 200) << str(empty);
+  expect_text_boxes(fig, img, {"title", "x_label", "y_label", "legend"});
+}
+
+TEST(LineChart, GapsNoDataAndBadSizes) {
+  EXPECT_EQ(round_trip(draw_line_chart({}, style(800, 600)), "line_chart_empty").width, 800);
+  LineChartData d;
+  d.series = {{"one", {1.0, 2.0, 3.0}, {1.0, std::nan(""), 3.0}, {0, 0, 0, 255}, Marker::Triangle}};
+  const Figure fig = draw_line_chart(d, style(800, 600));
+  EXPECT_GT(at(fig.image, fig.axes[0], {1.5, 1.5}).r, 200);  // a gap: no black line from (1, 1) to (2, 2)
+  EXPECT_LT(at(fig.image, fig.axes[0], {1.0, 1.0}).r, 50);   // but the marker of (1, 1)
+  d.series[0].y.pop_back();
+  EXPECT_THROW(draw_line_chart(d, style(800, 600)), RenderError);
+}
+
 }  // namespace
 }  // namespace paddock::render

@@ -287,5 +287,89 @@ TEST(Scenario, TheReadmesTableOfKeysIsCurrent) {
                     << "\nrun ./paddock keys and paste its table into the README between the markers";
 }
 
+// ---- a vehicle file on its own (paddock report vehicle) ----
+
+// a vehicle file in a scratch folder; `text` may include the default car by its absolute path
+std::string vehicle_file(const std::string& name, const std::string& text) {
+  const fs::path d = fs::temp_directory_path() / "paddock_vehicle_file_test";
+  fs::create_directories(d);
+  const std::string p = (d / (name + ".ini")).string();
+  std::ofstream(p) << text;
+  return p;
+}
+
+std::string vehicle_error(const std::string& path) {
+  try {
+    load_vehicle_file(path);
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+const std::string kIncludeCar = "include = " + kRoot + "/scenarios/vehicles/default.ini\n";
+
+TEST(VehicleFile, TheDefaultCarIsTheScenariosCar) {
+  Scenario from_file, from_scenario = load_scenario(kDefault);
+  from_file.vehicle = load_vehicle_file(kRoot + "/scenarios/vehicles/default.ini");
+  const std::vector<Key> a = scenario_keys(from_file), b = scenario_keys(from_scenario);
+  int compared = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (a[i].section != "vehicle") continue;
+    EXPECT_EQ(a[i].get(), b[i].get()) << a[i].name;
+    ++compared;
+  }
+  EXPECT_EQ(compared, static_cast<int>(params::field_paths(vehicle::VehicleParams{}).size()));
+}
+
+TEST(VehicleFile, OverridesAfterAnIncludeWin) {
+  const auto p = vehicle_file("override", kIncludeCar + "[vehicle]\nc_drag = 0\nmass = 250 ; heavier\n");
+  const vehicle::VehicleParams v = load_vehicle_file(p);
+  EXPECT_EQ(v.c_drag, 0.0);
+  EXPECT_EQ(v.mass, 250.0);
+}
+
+TEST(VehicleFile, BadInputIsAFileLineErrorLikeAScenarios) {
+  const auto unknown = vehicle_file("unknown", kIncludeCar + "[vehicle]\nmass = 190\nmas = 3\n");
+  EXPECT_THAT(vehicle_error(unknown), HasSubstr(unknown + ":4: unknown key 'mas' in [vehicle]; expected one of: mass, "));
+  const auto section = vehicle_file("section", kIncludeCar + "[control]\nlateral = stanley\n");
+  EXPECT_THAT(vehicle_error(section), HasSubstr(section + ":3: unknown section [control]; expected one of: [vehicle]"));
+  const auto number = vehicle_file("number", kIncludeCar + "[vehicle]\ntyre_d = grippy\n");
+  EXPECT_THAT(vehicle_error(number), HasSubstr(number + ":3: [vehicle] tyre_d = 'grippy' is not a number"));
+  const auto range = vehicle_file("range", kIncludeCar + "[vehicle]\nmass = 0.001\n");
+  EXPECT_THAT(vehicle_error(range), HasSubstr(range + ":3: [vehicle] mass = 0.001 is out of range; expected in [50, 2000] kg"));
+  const auto unset = vehicle_file("unset", "[vehicle]\nmass = 190\n");
+  EXPECT_THAT(vehicle_error(unset), HasSubstr(unset + ": [vehicle] inertia_z is not set (kg m^2)"));
+  EXPECT_THAT(vehicle_error(kRoot + "/scenarios/vehicles/no_such_car.ini"), HasSubstr("no_such_car.ini: cannot open"));
+}
+
+TEST(VehicleFile, ACarTheDefaultStepCannotIntegrateIsRejected) {
+  // exactly the cars whose stable step (the model's own figure) is under the
+  // default 1 ms; the light, stiff and grippy one is, for the single-track model
+  struct Candidate {
+    const char* name;
+    const char* lines;
+    void (*set)(vehicle::VehicleParams&);
+  };
+  const Candidate candidates[] = {
+      {"as_is", "", [](vehicle::VehicleParams&) {}},
+      {"stiff", "mass = 50\ninertia_z = 5\ntyre_b = 50\ntyre_d = 3\n",
+       [](vehicle::VehicleParams& v) { v.mass = 50, v.inertia_z = 5, v.tyre_b = 50, v.tyre_d = 3; }},
+      {"heavy", "mass = 2000\ninertia_z = 3000\nwheel_radius = 0.6\n",
+       [](vehicle::VehicleParams& v) { v.mass = 2000, v.inertia_z = 3000, v.wheel_radius = 0.6; }},
+  };
+  const vehicle::VehicleParams car = load_vehicle_file(kRoot + "/scenarios/vehicles/default.ini");
+  for (const Candidate& c : candidates) {
+    vehicle::VehicleParams v = car;
+    c.set(v);
+    const auto p = vehicle_file(c.name, kIncludeCar + "[vehicle]\n" + c.lines);
+    if (vehicle::stable_step_limit(v) < 1e-3) {
+      EXPECT_THAT(vehicle_error(p), HasSubstr(p + ": [vehicle] at the default physics rate: sim.physics_rate must be at least"));
+    } else {
+      EXPECT_EQ(vehicle_error(p), "(no error)") << c.name;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace paddock::runner
