@@ -19,6 +19,12 @@ const char* to_string(Mission m) {
   return "trackdrive";
 }
 
+const char* to_string(SlamMode m) {
+  for (const auto& c : AutonomyModes::kSlamNames)
+    if (c.value == m) return c.name;
+  return "ground_truth";
+}
+
 const char* to_string(PerceptionMode m) {
   switch (m) {
     case PerceptionMode::GroundTruth: return "ground_truth";

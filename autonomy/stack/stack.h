@@ -177,6 +177,8 @@ class Stack {
   const Telemetry& telemetry() const { return telemetry_; }
   const Trajectory& trajectory() const { return trajectory_; }
   const slam::ConeMap& cone_map() const { return cone_map_; }
+  // the state estimate the stack drives on (the newest), if any
+  const std::optional<hal::StateEstimate>& estimate() const { return state_; }
   // the last planning cycle's result (planner = delaunay), for plots
   const planning::PlanResult& last_plan() const { return last_plan_; }
   // the map the last plan was made on (its triangulation indexes these)
@@ -248,5 +250,6 @@ class Stack {
 const char* to_string(Mission m);
 // the scenario's names: ground_truth, lidar, lidar_camera
 const char* to_string(PerceptionMode m);
+const char* to_string(SlamMode m);
 
 }  // namespace paddock::stack

@@ -100,6 +100,28 @@ void SnapshotRecorder::observe(const SimModel& model, SimState& s) {
   }
 }
 
+void SlamScorer::observe(const SimModel&, SimState& s) {
+  if (!s.sampled || !s.stack.estimate()) return;
+  const hal::StateEstimate& e = *s.stack.estimate();
+  const Pose2 truth = s.true_poses.at(e.stamp);
+  const double d = distance(e.pose.position(), truth.position());
+  const double h = wrap_angle(e.pose.yaw - truth.yaw);
+  sum2_ += d * d;
+  heading2_ += h * h;
+  max_ = std::max(max_, d);
+  ++n_;
+}
+
+SlamMetrics SlamScorer::metrics() const {
+  SlamMetrics m;
+  m.samples = n_;
+  if (n_ == 0) return m;
+  m.ate_rms = std::sqrt(sum2_ / static_cast<double>(n_));
+  m.heading_rms = std::sqrt(heading2_ / static_cast<double>(n_));
+  m.ate_max = max_;
+  return m;
+}
+
 void tracking_from_log(const std::vector<events::Lap>& laps, const std::vector<LogRow>& log, double log_dt,
                        std::vector<LapTracking>& per_lap, Tracking& all) {
   per_lap.assign(laps.size(), LapTracking{});

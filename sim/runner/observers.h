@@ -95,6 +95,25 @@ class LogRecorder final : public Observer {
   std::vector<LogRow> rows_;
 };
 
+// how far the stack's state estimate lies from the truth: at every log
+// sample, the newest estimate against the true pose at the estimate's own
+// stamp (so a 200 Hz estimate is not blamed for its age)
+struct SlamMetrics {
+  double ate_rms = 0.0;      // m, position error (absolute trajectory error)
+  double ate_max = 0.0;      // m
+  double heading_rms = 0.0;  // rad
+  long samples = 0;
+};
+class SlamScorer final : public Observer {
+ public:
+  void observe(const SimModel& model, SimState& state) override;
+  SlamMetrics metrics() const;
+
+ private:
+  double sum2_ = 0.0, heading2_ = 0.0, max_ = 0.0;
+  long n_ = 0;
+};
+
 // the perception metrics: every frame of cones the stack received, against
 // the truth of the frame's instant (the true pose, the cones as they stood,
 // the cones the sensor could see at all)

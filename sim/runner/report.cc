@@ -78,6 +78,8 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
     << ", total " << fixed(ev.total_time, 3) << " s\n";
   o << "  tracking    rms " << fixed(r.tracking.rms, 3) << " m, max " << fixed(r.tracking.max, 3) << " m, ITAE "
     << fixed(r.tracking.itae, 1) << " (mean per lap)\n";
+  o << "  slam        " << stack::to_string(s.autonomy.slam) << ": ATE rms " << fixed(r.slam.ate_rms, 3) << " m, max "
+    << fixed(r.slam.ate_max, 3) << " m, heading rms " << fixed(r.slam.heading_rms, 4) << " rad\n";
   o << "  energy      " << fixed(r.energy / 3600.0, 1) << " Wh drawn from the accumulator over the run (regeneration counted off)\n";
   if (r.perception.frames() > 0) {
     o << "  perception  " << stack::to_string(s.autonomy.perception) << ", " << r.perception.frames()
@@ -168,6 +170,8 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"realtime_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0},
       {"tracking", tracking(r.tracking.rms, r.tracking.max, r.tracking.itae)},
       {"energy", r.energy},
+      {"slam", {{"mode", stack::to_string(s.autonomy.slam)}, {"ate_rms_m", r.slam.ate_rms}, {"ate_max_m", r.slam.ate_max},
+                {"heading_rms_rad", r.slam.heading_rms}, {"samples", r.slam.samples}}},
       {"perception", perception},
       {"stack", {{"fallbacks", r.fallbacks}, {"fault", r.fault}}},
       {"expectations_failed", failed},

@@ -194,8 +194,9 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track) {
   SimState state(model);
   LogRecorder log;
   PerceptionScorer scorer;
+  SlamScorer slam;
   SnapshotRecorder snapshot;
-  Observer* const observers[] = {&snapshot, &scorer, &log};
+  Observer* const observers[] = {&snapshot, &scorer, &slam, &log};
   for (;;) {
     for (Observer* o : observers) o->observe(model, state);
     if (state.done) break;
@@ -207,6 +208,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track) {
   result.sim_time = result.log.empty() ? 0.0 : result.log.back().t;
   tracking_from_log(result.event.laps, result.log, 1.0 / scenario.sim.log_rate, result.lap_tracking, result.tracking);
   result.perception = scorer.metrics();
+  result.slam = slam.metrics();
   result.snapshot = std::move(snapshot.snapshot());
   result.wall_time = seconds_since(wall0);
   return result;

@@ -117,6 +117,7 @@ struct RunResult {
   std::string fault;       // the stack's last fault, if any
   int cycles = 0;          // control cycles run
   PerceptionMetrics perception;  // the stack's perceived cones against the truth, per range bin
+  SlamMetrics slam;              // the stack's state estimate against the truth
   std::optional<PerceptionSnapshot> snapshot;
 };
 

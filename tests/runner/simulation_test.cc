@@ -161,6 +161,17 @@ TEST(Simulation, ADivergingCarEndsTheRunWithItsReasonNotACrash) {
   EXPECT_LT(r.sim_time, 11.0);  // it stopped before the event's timeout
 }
 
+TEST(Simulation, WithTheTrueStateTheSlamErrorIsExactlyZero) {
+  // slam = ground_truth hands the stack the true pose: scored against the
+  // truth at the estimate's own stamp, every sample is exact
+  const ScenarioOnTrack& s = default_setup();
+  const RunResult r = run(s.scenario, s.track);
+  EXPECT_GT(r.slam.samples, 1000);
+  EXPECT_EQ(r.slam.ate_rms, 0.0);
+  EXPECT_EQ(r.slam.ate_max, 0.0);
+  EXPECT_EQ(r.slam.heading_rms, 0.0);
+}
+
 TEST(Simulation, StreamSeedsDifferPerStream) {
   const char* streams[] = {"cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera", "detector"};
   for (const char* a : streams) {
