@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -14,6 +17,7 @@
 #include <functional>
 #include <limits>
 #include <set>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -227,6 +231,204 @@ TEST(VelocityEkfTest, LivelyDriveTracksTheTruth) {
   // held within a third of the sensor's turn-on spread over the drive
   EXPECT_GT(std::abs(run.samples.front().gyro_bias), 3e-4) << "a seed whose bias is worth learning";
   EXPECT_LT(bias_err_max, 3e-4);
+}
+
+// the NEES of (vx, vy, r): e^T Sigma^-1 e
+double nees(const Sample& s) {
+  const Eigen::Vector3d e(s.est.vx - s.vx, s.est.vy - s.vy, s.est.yaw_rate - s.r);
+  return e.dot(s.cov.ldlt().solve(e));
+}
+
+// the chi-square 95 % quantile for 3 degrees of freedom
+constexpr double kChi2_3_95 = 7.815;
+
+TEST(VelocityEkfTest, CovarianceIsConsistentOverSeeds) {
+  const vehicle::VehicleParams& car = default_car();
+  std::size_t inside = 0, total = 0;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const DriveLog run = drive(car, vehicle::initial_state(car, Pose2{}), lively, kStart + 30.0, seed);
+    std::size_t in_seed = 0;
+    double sum = 0.0;
+    Eigen::Vector3d each = Eigen::Vector3d::Zero();
+    for (const Sample& s : run.samples) {
+      const Eigen::Vector3d e(s.est.vx - s.vx, s.est.vy - s.vy, s.est.yaw_rate - s.r);
+      for (int i = 0; i < 3; ++i) each(i) += e(i) * e(i) / s.cov(i, i) / static_cast<double>(run.samples.size());
+      const double n = nees(s);
+      sum += n;
+      in_seed += n <= kChi2_3_95;
+    }
+    std::printf("seed %d: NEES mean %.2f (3 if consistent), within the 95 %% bound %.1f %% of %zu samples; vx rms %.4f\n",
+                static_cast<int>(seed), sum / static_cast<double>(run.samples.size()),
+                100.0 * static_cast<double>(in_seed) / static_cast<double>(run.samples.size()), run.samples.size(),
+                errors_of(run).vx_rms);
+    if (std::getenv("EKF_DUMP")) std::printf("  per component: vx %.2f vy %.2f r %.2f\n", each(0), each(1), each(2));
+    inside += in_seed;
+    total += run.samples.size();
+  }
+  EXPECT_GE(static_cast<double>(inside), 0.9 * static_cast<double>(total));
+}
+
+TEST(VelocityEkfTest, SpinningWheelsOnLowGripAreRejected) {
+  vehicle::VehicleParams car = default_car();
+  car.tyre_d = car.tyre_dx = 0.6;
+  car.traction_control_slip = 0.0;
+  const auto full_throttle = [](double t) {
+    vehicle::DriverInput in;
+    if (t < 1.0) in.brake = 0.3;
+    else in.throttle = 1.0;
+    return in;
+  };
+  const DriveLog run = drive(car, vehicle::initial_state(car, Pose2{}), full_throttle, 6.0, 2);
+  std::size_t spinning = 0, flagged = 0;
+  double worst = 0.0, worst_wheel = 0.0;
+  for (const Sample& s : run.samples) {
+    worst = std::max(worst, std::abs(s.est.vx - s.vx));
+    const double slip = *std::max_element(s.slip.begin(), s.slip.end());
+    if (slip > 0.1) {
+      ++spinning;
+      flagged += s.est.wheels_used < 4;
+      worst_wheel = std::max(worst_wheel, slip);
+    }
+  }
+  const Sample& end = run.samples.back();
+  std::printf("spin: %zu samples with a wheel over 10 %% slip (largest %.2f), %zu of them with a wheel rejected; "
+              "largest vx error %.3f m/s at vx up to %.1f m/s\n",
+              spinning, worst_wheel, flagged, worst, end.vx);
+  EXPECT_GT(spinning, 100u) << "the car must spin its wheels for the test to mean something";
+  EXPECT_GE(static_cast<double>(flagged), 0.95 * static_cast<double>(spinning));
+  EXPECT_LT(worst, 0.3);
+}
+
+TEST(VelocityEkfTest, LockedWheelsUnderFullBrakingAreRejected) {
+  const vehicle::VehicleParams& car = default_car();
+  const auto full_brake = [](double t) {
+    vehicle::DriverInput in;
+    in.brake = t < 1.0 ? 0.0 : 1.0;
+    return in;
+  };
+  const DriveLog run = drive(car, vehicle::rolling_state(car, Pose2{}, 20.0), full_brake, 4.0, 3);
+  double worst = 0.0, most_locked = 0.0;
+  std::size_t locked = 0, flagged = 0;
+  for (const Sample& s : run.samples) {
+    worst = std::max(worst, std::abs(s.est.vx - s.vx));
+    const double slip = *std::min_element(s.slip.begin(), s.slip.end());
+    most_locked = std::min(most_locked, slip);
+    if (slip < -0.5) {
+      ++locked;
+      flagged += s.est.wheels_used < 4;
+    }
+  }
+  std::printf("lock: %zu samples with a wheel below -50 %% slip (lowest %.2f), %zu of them with a wheel rejected; "
+              "largest vx error %.3f m/s\n",
+              locked, most_locked, flagged, worst);
+  EXPECT_GT(locked, 20u) << "the wheels must lock for the test to mean something";
+  EXPECT_EQ(flagged, locked);
+  EXPECT_LT(worst, 0.3);
+  EXPECT_LT(std::abs(run.samples.back().est.vx), 0.01);
+}
+
+TEST(VelocityEkfTest, StandstillDoesNotDrift) {
+  const vehicle::VehicleParams& car = default_car();
+  const auto parked = [](double) {
+    vehicle::DriverInput in;
+    in.brake = 0.3;
+    return in;
+  };
+  const DriveLog run = drive(car, vehicle::initial_state(car, Pose2{1.0, 2.0, 0.5}), parked, 10.0, 4);
+  const Sample& end = run.samples.back();
+  const double drift = distance(end.est.pose.position(), end.pose.position());
+  std::printf("standstill: position drift %.2e m, yaw drift %.2e rad, vx %.1e m/s\n", drift,
+              wrap_angle(end.est.pose.yaw - end.pose.yaw), end.est.vx);
+  EXPECT_LT(drift, 0.01);
+  EXPECT_LT(std::abs(end.est.vx), 0.005);
+  EXPECT_EQ(end.est.wheels_used, 4);
+}
+
+TEST(VelocityEkfTest, BadMessagesAreRejectedAndTheStateStaysFinite) {
+  VelocityEkf ekf({}, CarGeometry{});
+  ekf.reset(Pose2{}, 0);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  const double w = 5.0 / 0.2;  // 5 m/s
+  std::size_t expected = 0;
+  for (int k = 1; k <= 200; ++k) {
+    const TimeNs t = k * 5'000'000;
+    EXPECT_EQ(ekf.on_imu(hal::Imu{t, 0.1, 0.0, 0.0}), EkfStatus::Ok);
+    if (k % 2 == 0) {
+      EXPECT_EQ(ekf.on_wheel_speeds(hal::WheelSpeeds{t, {w, w, w, w}}), EkfStatus::Ok);
+    }
+    if (k == 50) {
+      // not finite
+      EXPECT_EQ(ekf.on_imu(hal::Imu{t + 1, nan, 0.0, 0.0}), EkfStatus::Rejected);
+      EXPECT_EQ(ekf.on_imu(hal::Imu{t + 1, 0.0, 0.0, inf}), EkfStatus::Rejected);
+      EXPECT_EQ(ekf.on_wheel_speeds(hal::WheelSpeeds{t + 1, {w, nan, w, w}}), EkfStatus::Rejected);
+      EXPECT_EQ(ekf.on_steering(hal::SteeringAngle{t + 1, nan}), EkfStatus::Rejected);
+      // out of order: an IMU sample before the filter's time, a wheel message
+      // before the previous one (and one far behind the filter), a steering angle before the previous one
+      EXPECT_EQ(ekf.on_imu(hal::Imu{t - 5'000'000, 0.0, 0.0, 0.0}), EkfStatus::Rejected);
+      EXPECT_EQ(ekf.on_wheel_speeds(hal::WheelSpeeds{t - 20'000'000, {w, w, w, w}}), EkfStatus::Rejected);
+      EXPECT_EQ(ekf.on_steering(hal::SteeringAngle{t, 0.0}), EkfStatus::Ok);
+      EXPECT_EQ(ekf.on_steering(hal::SteeringAngle{t - 1, 0.0}), EkfStatus::Rejected);
+      expected += 7;
+    }
+  }
+  const VelocityEstimate e = ekf.estimate();
+  EXPECT_EQ(ekf.rejected(), expected);
+  EXPECT_TRUE(finite(e.pose) && finite(e.vx) && finite(e.vy) && finite(e.yaw_rate));
+  for (double v : e.variance) EXPECT_TRUE(finite(v) && v >= 0.0);
+  EXPECT_NEAR(e.vx, 5.0, 0.05);
+  EXPECT_EQ(e.stamp, 200 * 5'000'000);
+}
+
+TEST(VelocityEkfTest, InvalidParamsThrow) {
+  VelocityEkfParams p;
+  p.accel_noise = -1.0;
+  EXPECT_THROW(VelocityEkf(p, CarGeometry{}), std::invalid_argument);
+  CarGeometry g;
+  g.wheel_radius = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(VelocityEkf({}, g), std::invalid_argument);
+  EXPECT_NO_THROW(VelocityEkf({}, CarGeometry{}));
+}
+
+TEST(VelocityEkfTest, SameSeedSameEstimates) {
+  const vehicle::VehicleParams& car = default_car();
+  const DriveLog a = drive(car, vehicle::initial_state(car, Pose2{}), lively, 12.0, 7);
+  const DriveLog b = drive(car, vehicle::initial_state(car, Pose2{}), lively, 12.0, 7);
+  ASSERT_EQ(a.samples.size(), b.samples.size());
+  for (std::size_t i = 0; i < a.samples.size(); ++i) {
+    const VelocityEstimate &x = a.samples[i].est, &y = b.samples[i].est;
+    ASSERT_EQ(x.pose.x, y.pose.x);
+    ASSERT_EQ(x.pose.y, y.pose.y);
+    ASSERT_EQ(x.pose.yaw, y.pose.yaw);
+    ASSERT_EQ(x.vx, y.vx);
+    ASSERT_EQ(x.vy, y.vy);
+    ASSERT_EQ(x.yaw_rate, y.yaw_rate);
+    ASSERT_EQ(x.gyro_bias, y.gyro_bias);
+    ASSERT_EQ(x.variance, y.variance);
+    ASSERT_EQ(x.wheels_used, y.wheels_used);
+  }
+}
+
+// an IMU predict and a wheel update take a few microseconds
+TEST(VelocityEkfTest, UpdatesAreFast) {
+  VelocityEkf ekf({}, CarGeometry{});
+  ekf.reset(Pose2{}, 0);
+  const int n = 20000;
+  const double w = 10.0 / 0.2;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 1; k <= n; ++k) ekf.on_imu(hal::Imu{2 * k * 5'000'000LL, 0.2, 1.0, 0.1});
+  const auto t1 = std::chrono::steady_clock::now();
+  for (int k = 1; k <= n; ++k) {
+    ekf.on_imu(hal::Imu{(2 * n + 2 * k) * 5'000'000LL, 0.2, 1.0, 0.1});
+    ekf.on_wheel_speeds(hal::WheelSpeeds{(2 * n + 2 * k) * 5'000'000LL, {w + 0.3, w - 0.3, w + 0.3, w - 0.3}});
+  }
+  const auto t2 = std::chrono::steady_clock::now();
+  const double predict_us = std::chrono::duration<double, std::micro>(t1 - t0).count() / n;
+  const double update_us = std::chrono::duration<double, std::micro>(t2 - t1).count() / n - predict_us;
+  std::printf("timing: predict %.2f us, wheel update %.2f us\n", predict_us, update_us);
+  EXPECT_TRUE(finite(ekf.estimate().vx));
+  // generous bounds for a loaded CI machine (a few us on an idle one)
+  EXPECT_LT(predict_us, 50.0);
+  EXPECT_LT(update_us, 50.0);
 }
 
 }  // namespace
