@@ -313,6 +313,9 @@ TEST(VelocityEkfTest, LockedWheelsUnderFullBrakingAreRejected) {
   std::size_t locked = 0, flagged = 0;
   for (const Sample& s : run.samples) {
     if (s.t >= 0.1) worst = std::max(worst, std::abs(s.est.vx - s.vx));
+    if (std::getenv("EKF_DUMP") && std::abs(s.est.vx - s.vx) > 0.1)
+      std::printf("t %.2f vx %.3f est %.3f used %d slip %.3f %.3f %.3f %.3f\n", s.t, s.vx, s.est.vx, s.est.wheels_used,
+                  s.slip[0], s.slip[1], s.slip[2], s.slip[3]);
     const double slip = *std::min_element(s.slip.begin(), s.slip.end());
     most_locked = std::min(most_locked, slip);
     if (slip < -0.5) {
