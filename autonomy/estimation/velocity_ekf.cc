@@ -21,6 +21,11 @@ std::string check_geometry(const CarGeometry& g) {
   if (!ok(g.track_front, 0.2, 5.0)) return "track_front must be in [0.2, 5] m (got " + params::number(g.track_front) + ")";
   if (!ok(g.track_rear, 0.2, 5.0)) return "track_rear must be in [0.2, 5] m (got " + params::number(g.track_rear) + ")";
   if (!ok(g.wheel_radius, 0.05, 2.0)) return "wheel_radius must be in [0.05, 2] m (got " + params::number(g.wheel_radius) + ")";
+  if (!ok(g.imu_x, -10.0, 10.0) || !ok(g.imu_y, -5.0, 5.0))
+    return "the IMU's mount must lie within 10 m of the rear axle (got " + params::number(g.imu_x) + ", " + params::number(g.imu_y) + ")";
+  if (!ok(g.slip_per_accel, 0.0, 1.0)) return "slip_per_accel must be in [0, 1] s^2/m (got " + params::number(g.slip_per_accel) + ")";
+  if (!ok(g.drag_per_mass, 0.0, 1.0)) return "drag_per_mass must be in [0, 1] 1/m (got " + params::number(g.drag_per_mass) + ")";
+  if (!ok(g.cornering_stiffness, 1e-3, 1000.0)) return "cornering_stiffness must be in (0, 1000] 1/rad (got " + params::number(g.cornering_stiffness) + ")";
   return "";
 }
 
@@ -96,7 +101,7 @@ EkfStatus VelocityEkf::on_imu(const hal::Imu& m) {
 
 void VelocityEkf::predict(double dt, double ax_m, double ay_m, double g_m) {
   const VelocityEkfParams& p = params_;
-  const double mx = p.imu_x, my = p.imu_y;
+  const double mx = geometry_.imu_x, my = geometry_.imu_y;
   const double yaw = x_(kYaw), vx = x_(kVx), vy = x_(kVy), r = x_(kR);
   const double ax = ax_m - x_(kBax), ay = ay_m - x_(kBay);
   const double rn = g_m - x_(kBr);
@@ -190,9 +195,9 @@ double VelocityEkf::modelled_slip() const {
   // the longitudinal acceleration of the base origin: the IMU's, bias
   // corrected, less its centripetal lever-arm term (-r^2 mx)
   const double r = x_(kR);
-  const double ax = ax_m_ - x_(kBax) + r * r * params_.imu_x;
+  const double ax = ax_m_ - x_(kBax) + r * r * geometry_.imu_x;
   const double vx = x_(kVx);
-  return params_.slip_per_accel * (ax + params_.drag_per_mass * vx * std::abs(vx));
+  return geometry_.slip_per_accel * (ax + geometry_.drag_per_mass * vx * std::abs(vx));
 }
 
 EkfStatus VelocityEkf::on_steering(const hal::SteeringAngle& m) {
@@ -228,7 +233,7 @@ EkfStatus VelocityEkf::on_wheel_speeds(const hal::WheelSpeeds& m) {
 
   const double R = geometry_.wheel_radius;
   const double r = x_(kR);
-  const double ax = has_imu_ ? ax_m_ - x_(kBax) + r * r * p.imu_x : 0.0;
+  const double ax = has_imu_ ? ax_m_ - x_(kBax) + r * r * geometry_.imu_x : 0.0;
   const double ay = has_imu_ ? ay_m_ - x_(kBay) : 0.0;
 
   // standstill: every wheel still and the IMU quiet for standstill_time (a
@@ -338,7 +343,7 @@ EkfStatus VelocityEkf::on_wheel_speeds(const hal::WheelSpeeds& m) {
     // taken as the measurement of vy alone (its Jacobian left out on purpose:
     // the model's error must not leak into vx, r or the gyro bias)
     {
-      const double model = -x_(kR) * x_(kVx) * x_(kVx) / (kGravity * p.cornering_stiffness);
+      const double model = -x_(kR) * x_(kVx) * x_(kVx) / (kGravity * geometry_.cornering_stiffness);
       Vector Hy = Vector::Zero();
       Hy(kVy) = 1.0;
       const double sigma = p.vy_std + p.vy_relative * std::abs(model);

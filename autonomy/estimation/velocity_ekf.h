@@ -110,11 +110,6 @@
 namespace paddock::estimation {
 
 struct VelocityEkfParams {
-  // IMU mounting point in the base frame: the simulator's [imu] mount_x,
-  // mount_y defaults (at the default car's CG); keep them in step with the IMU
-  double imu_x = 0.765;
-  double imu_y = 0.0;
-
   // the IMU's white noise per sample, at its rate: the sensor's data sheet
   // (the simulated IMU's defaults, sim/sensors/imu.h)
   double accel_noise = 0.02;
@@ -139,11 +134,6 @@ struct VelocityEkfParams {
   // wheel-speed measurement: the encoder's white noise (0.05 rad/s) with its
   // quantisation (0.0767 / sqrt(12) = 0.022 rad/s)
   double wheel_noise = 0.055;
-  // the tyres' slip: per m/s^2 of the car's acceleration, 1 / (g B_x C D_x)
-  // of the default car's tyre (14 * 1.45 * 1.6 = 32.5 per unit slip)
-  double slip_per_accel = 3.1e-3;
-  // drag over mass of the default car (0.7 / 210): the tyres also push against it
-  double drag_per_mass = 3.3e-3;
   // the slip the model does not explain (rolling resistance, road): 0.3 %
   double slip_std = 0.003;
   // and the share of the modelled slip it gets wrong; both common to the four
@@ -165,9 +155,7 @@ struct VelocityEkfParams {
   double consistency_relative = 0.03;
   double drive_threshold = 0.005;  // slip ratio: 1.6 m/s^2 of driving or braking force
 
-  // the rear axle's lateral slip pseudo-measurement: the default car's lateral
-  // B C D = 11 * 1.45 * 1.7 = 27 per rad
-  double cornering_stiffness = 27.0;
+  // the rear axle's lateral slip pseudo-measurement (its stiffness: CarGeometry)
   // its error is not white: it lasts as long as a transient or a corner near
   // the limit (the tyre's saturation), so at 100 Hz it must be weak. 0.3 m/s
   // and half the modelled value: on the simulated car the NEES of vy is then
@@ -193,8 +181,6 @@ struct VelocityEkfParams {
 
   template <class V>
   void visit(V& v) {
-    v(PADDOCK_PARAM(imu_x), {"m", params::in(-10.0, 10.0), "IMU position ahead of the rear axle"});
-    v(PADDOCK_PARAM(imu_y), {"m", params::in(-5.0, 5.0), "IMU position left of the centre"});
     v(PADDOCK_PARAM(accel_noise), {"m/s^2", params::above_up_to(0.0, 100.0), "accelerometer white noise std per sample"});
     v(PADDOCK_PARAM(gyro_noise), {"rad/s", params::above_up_to(0.0, 10.0), "gyro white noise std per sample"});
     v(PADDOCK_PARAM(accel_bias_walk), {"m/s^2/sqrt(s)", params::in(0.0, 10.0), "accelerometer bias random walk"});
@@ -205,8 +191,6 @@ struct VelocityEkfParams {
     v(PADDOCK_PARAM(accel_bias_std_initial), {"m/s^2", params::above_up_to(0.0, 10.0), "accelerometer bias std at reset"});
     v(PADDOCK_PARAM(gyro_bias_std_initial), {"rad/s", params::above_up_to(0.0, 1.0), "gyro bias std at reset"});
     v(PADDOCK_PARAM(wheel_noise), {"rad/s", params::above_up_to(0.0, 100.0), "wheel-speed white noise std (quantisation included)"});
-    v(PADDOCK_PARAM(slip_per_accel), {"s^2/m", params::in(0.0, 1.0), "tyre slip ratio per m/s^2 of driving force over mass"});
-    v(PADDOCK_PARAM(drag_per_mass), {"1/m", params::in(0.0, 1.0), "aerodynamic drag over mass: the tyres push against drag_per_mass vx^2"});
     v(PADDOCK_PARAM(slip_std), {"", params::in(0.0, 1.0), "slip ratio std the model does not explain"});
     v(PADDOCK_PARAM(slip_model_error), {"", params::in(0.0, 10.0), "relative error of the modelled slip, common to the wheels"});
     v(PADDOCK_PARAM(wheel_slip_std), {"", params::in(0.0, 1.0), "slip ratio std of each wheel on its own"});
@@ -216,7 +200,6 @@ struct VelocityEkfParams {
     v(PADDOCK_PARAM(consistency_tolerance), {"m/s", params::above(0.0), "a wheel's implied vx further than this (+ relative) from the reference is rejected"});
     v(PADDOCK_PARAM(consistency_relative), {"", params::in(0.0, 1.0), "the consistency tolerance's share of |vx|"});
     v(PADDOCK_PARAM(drive_threshold), {"", params::above(0.0), "modelled slip ratio above which the slowest wheel (below: minus it, the fastest) is the reference"});
-    v(PADDOCK_PARAM(cornering_stiffness), {"1/rad", params::above_up_to(0.0, 1000.0), "rear tyres' lateral force per load per rad of slip angle"});
     v(PADDOCK_PARAM(vy_std), {"m/s", params::above_up_to(0.0, 100.0), "std of the rear axle's lateral slip pseudo-measurement"});
     v(PADDOCK_PARAM(vy_relative), {"", params::in(0.0, 10.0), "its relative std, of the modelled lateral velocity"});
     v(PADDOCK_PARAM(standstill_wheel_speed), {"rad/s", params::at_least(0.0), "every wheel slower than this (with the IMU quiet): at rest"});
@@ -228,9 +211,21 @@ struct VelocityEkfParams {
   }
 };
 
-// what the estimator knows of the car (the runner fills it from [vehicle])
+// what the estimator knows of the car and where its IMU sits: not
+// parameters of its own, the runner fills them from [vehicle] and [imu]
+// (the defaults are the default car's)
 struct CarGeometry {
   double lf = 0.81, lr = 0.72, track_front = 1.22, track_rear = 1.18, wheel_radius = 0.2;
+  // the IMU's mounting point in the base frame (m): [imu] mount_x, mount_y
+  double imu_x = 0.765;
+  double imu_y = 0.0;
+  // the tyres' slip per m/s^2 of the car's acceleration, 1 / (g B_x C D_x)
+  // (14 * 1.45 * 1.6 = 32.5 per unit slip)
+  double slip_per_accel = 3.1e-3;
+  // drag over mass (0.7 / 210): the tyres also push against it
+  double drag_per_mass = 3.3e-3;
+  // the rear tyres' lateral force per load per rad of slip, B C D (11 * 1.45 * 1.7 = 27)
+  double cornering_stiffness = 27.0;
 };
 
 // the state order of VelocityEstimate::variance and of the filter

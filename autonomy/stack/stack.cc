@@ -45,6 +45,10 @@ Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<percep
     pp.use_camera = params_.autonomy.perception == PerceptionMode::LidarCamera;
     perception_ = std::make_unique<perception::Perception>(pp, std::move(detector));
   }
+  if (params_.autonomy.slam == SlamMode::Odometry) {
+    ekf_.emplace(params_.slam.velocity, params_.slam.geometry);
+    ekf_->reset(spec_.start_pose, 0);
+  }
   if (params_.autonomy.planner != PlannerMode::Oracle) return;
   // planner = oracle: the whole reference is planned once, before the start;
   // an open path starts free (the car launches at full drive) and ends at rest
@@ -58,11 +62,35 @@ Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<percep
   }
 }
 
+void Stack::take_estimate(const hal::StateEstimate& est) {
+  state_ = est;
+  history_.push_back(est);
+  while (!history_.empty() && est.stamp - history_.front().stamp > kNsPerSecond) history_.pop_front();
+}
+
 void Stack::on_message(hal::SensorMessage&& m) {
+  // the odometry sensors feed the estimator (slam = odometry) and the LiDAR's
+  // motion correction (perception = lidar | lidar_camera)
+  if (const auto* imu = std::get_if<hal::Imu>(&m)) {
+    if (ekf_ && ekf_->on_imu(*imu) == estimation::EkfStatus::Ok) {
+      const estimation::VelocityEstimate e = ekf_->estimate();
+      take_estimate(hal::StateEstimate{e.stamp, e.pose, e.vx, e.vy, e.yaw_rate});
+    }
+    if (perception_) perception_->add(*imu);
+    return;
+  }
+  if (const auto* wheels = std::get_if<hal::WheelSpeeds>(&m)) {
+    if (ekf_) ekf_->on_wheel_speeds(*wheels);
+    if (perception_) perception_->add(*wheels);
+    return;
+  }
+  if (const auto* steering = std::get_if<hal::SteeringAngle>(&m)) {
+    if (ekf_) ekf_->on_steering(*steering);
+    return;
+  }
   if (const auto* est = std::get_if<hal::StateEstimate>(&m)) {
-    state_ = *est;
-    history_.push_back(*est);
-    while (!history_.empty() && est->stamp - history_.front().stamp > kNsPerSecond) history_.pop_front();
+    // slam = ground_truth: handed in; otherwise the stack keeps its own
+    if (!ekf_) take_estimate(*est);
   } else if (const auto* det = std::get_if<hal::ConeDetections>(&m)) {
     on_detections(*det);
   } else if (const auto* res = std::get_if<hal::ResSignal>(&m)) {
@@ -76,10 +104,6 @@ void Stack::on_message(hal::SensorMessage&& m) {
     perception_->add(std::move(*boxes));
   } else if (const auto* frame = std::get_if<hal::CameraFrame>(&m)) {
     perception_->add(*frame);
-  } else if (const auto* imu = std::get_if<hal::Imu>(&m)) {
-    perception_->add(*imu);
-  } else if (const auto* wheels = std::get_if<hal::WheelSpeeds>(&m)) {
-    perception_->add(*wheels);
   }
 }
 

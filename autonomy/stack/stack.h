@@ -17,6 +17,7 @@
 #include "autonomy/perception/perception.h"
 #include "autonomy/planning/path_planner.h"
 #include "autonomy/planning/skidpad.h"
+#include "autonomy/estimation/velocity_ekf.h"
 #include "autonomy/slam/cone_map.h"
 #include "autonomy/stack/gates.h"
 
@@ -27,13 +28,14 @@ namespace paddock::stack {
 // cone detections; lidar = the LiDAR pipeline on raw scans (intensity colour);
 // lidar_camera = the LiDAR pipeline fused with the camera detector's boxes
 enum class PerceptionMode { GroundTruth, Lidar, LidarCamera };
-enum class SlamMode { GroundTruth };
+enum class SlamMode { GroundTruth, Odometry };
 enum class PlannerMode { Oracle, Delaunay };
 
 struct AutonomyModes {
   static constexpr params::Choice<PerceptionMode> kPerceptionNames[] = {
       {"ground_truth", PerceptionMode::GroundTruth}, {"lidar", PerceptionMode::Lidar}, {"lidar_camera", PerceptionMode::LidarCamera}};
-  static constexpr params::Choice<SlamMode> kSlamNames[] = {{"ground_truth", SlamMode::GroundTruth}};
+  static constexpr params::Choice<SlamMode> kSlamNames[] = {{"ground_truth", SlamMode::GroundTruth},
+                                                            {"odometry", SlamMode::Odometry}};
   static constexpr params::Choice<PlannerMode> kPlannerNames[] = {{"delaunay", PlannerMode::Delaunay},
                                                                   {"oracle", PlannerMode::Oracle}};
   PerceptionMode perception = PerceptionMode::GroundTruth;
@@ -101,6 +103,18 @@ struct MissionParams {
   }
 };
 
+// [slam]: how the stack estimates its own state (slam != ground_truth)
+struct SlamParams {
+  estimation::VelocityEkfParams velocity;
+  // not visited: the runner fills it from the vehicle ([vehicle])
+  estimation::CarGeometry geometry;
+
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(velocity), "the velocity and odometry EKF: IMU, wheel speeds, steering angle (slam = odometry)");
+  }
+};
+
 struct StackParams {
   AutonomyModes autonomy;
   // perception = lidar | lidar_camera (use_camera follows the mode)
@@ -115,6 +129,7 @@ struct StackParams {
   MissionParams mission;
   slam::ConeMapParams cone_map;
   GateParams gates;
+  SlamParams slam;
 
   template <class V>
   void visit(V& v) {
@@ -126,6 +141,7 @@ struct StackParams {
     v.section(PADDOCK_PARAM(mission), "the mission logic of each event");
     v.section(PADDOCK_PARAM(cone_map), "the stack's map of cones");
     v.section(PADDOCK_PARAM(gates), "timekeeping gates from the big orange cones");
+    v.section(PADDOCK_PARAM(slam), "the stack's own state estimation (slam != ground_truth)");
   }
   std::string check() const {
     const std::string why = params::validate(vehicle);
@@ -146,6 +162,10 @@ struct MissionSpec {
   // planner = oracle: the reference path (a centreline) known in advance
   std::vector<Vec2> oracle_path;
   bool oracle_closed = false;
+  // where the team placed the car on the grid (the base frame's pose): the
+  // origin of the stack's own estimate (slam != ground_truth); the identity
+  // when unknown
+  Pose2 start_pose;
 };
 
 // what the stack reports of itself each cycle (telemetry, for logs)
@@ -194,6 +214,8 @@ class Stack {
 
  private:
   void on_message(hal::SensorMessage&& m);
+  // a state estimate the stack now drives on (handed in, or its own)
+  void take_estimate(const hal::StateEstimate& est);
   void on_detections(const hal::ConeDetections& d);
   void add_to_map(const hal::ConeDetections& d);
   // the base pose at time t from the recent state estimates (interpolated), if known
@@ -220,6 +242,8 @@ class Stack {
   Telemetry telemetry_;
   std::unique_ptr<perception::Perception> perception_;
 
+  // slam = odometry: the estimator fed by the IMU, the wheel speeds and the steering angle
+  std::optional<estimation::VelocityEkf> ekf_;
   std::optional<hal::StateEstimate> state_;
   std::deque<hal::StateEstimate> history_;  // the last second of state estimates, oldest first
   slam::ConeMap cone_map_;

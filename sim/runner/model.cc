@@ -45,6 +45,8 @@ SimModel compile_model(const Scenario& scenario, const world::TrackModel& track)
   m.start = start_pose(track, m.footprint.x_max);
   m.stack = stack_params(scenario);
   m.mission = mission_for(scenario.scenario.event, track, scenario.autonomy.planner);
+  // where the team placed the car: the origin of the stack's own estimate
+  m.mission.start_pose = m.start;
 
   // the object-level sensor knows the cones' true sizes; the raw sensors see them
   m.cone_sensor = scenario.cone_sensor;

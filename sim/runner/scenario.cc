@@ -310,6 +310,21 @@ stack::StackParams stack_params(const Scenario& s) {
   p.perception.lidar.calibration = static_cast<const hal::LidarLayout&>(s.lidar);
   p.perception.camera = sensors::camera_calibration(s.camera);
   p.planning = s.planning;
+  p.slam = s.slam;
+  // the estimator's knowledge of the car: its geometry, where the IMU sits,
+  // and the tyres' slip stiffnesses (the slip the wheels show per
+  // acceleration, the rear axle's cornering stiffness)
+  estimation::CarGeometry& g = p.slam.geometry;
+  g.lf = v.lf;
+  g.lr = v.lr;
+  g.track_front = v.track_front;
+  g.track_rear = v.track_rear;
+  g.wheel_radius = v.wheel_radius;
+  g.imu_x = s.imu.mount_x;
+  g.imu_y = s.imu.mount_y;
+  g.slip_per_accel = 1.0 / (kGravity * v.tyre_bx * v.tyre_c * v.tyre_dx);
+  g.drag_per_mass = v.c_drag / v.mass;
+  g.cornering_stiffness = v.tyre_b * v.tyre_c * v.tyre_d;
   p.planning.reference.profile.mass = v.mass;
   p.planning.reference.profile.drag_coefficient = v.c_drag;
   // the skidpad's reference uses the same planned limits

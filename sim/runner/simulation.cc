@@ -48,8 +48,12 @@ void control(const SimModel& model, SimState& s, const Pose2& base) {
     s.hal.post(std::move(s.in_flight.front().second));
     s.in_flight.pop_front();
   }
-  const Vec2 v = vehicle::base_velocity(model.scenario.vehicle, s.car);
-  s.hal.post(hal::StateEstimate{s.now, base, v.x, v.y, s.car.r});
+  // slam = ground_truth: the stack is handed its true state; otherwise it
+  // estimates its own from the sensors (the HAL refuses the truth then)
+  if (s.hal.true_state()) {
+    const Vec2 v = vehicle::base_velocity(model.scenario.vehicle, s.car);
+    s.hal.post(hal::StateEstimate{s.now, base, v.x, v.y, s.car.r});
+  }
   if (!s.go_sent && s.now >= model.go) {
     s.hal.post(hal::ResSignal{s.now, true, false});
     s.go_sent = true;
@@ -147,6 +151,7 @@ SimState::SimState(const SimModel& model)
             world::Footprint{-model.footprint.x_min, model.footprint.x_max, model.footprint.y_max}),
       event(model.scenario.scenario.event, model.track, model.scenario.event),
       stack(model.stack, model.mission),
+      hal(model.stack.autonomy.slam == stack::SlamMode::GroundTruth),
       cone_sensor(model.cone_sensor, stream_seed(model.scenario.scenario.seed, "cone_sensor")),
       cones_now(model.cones.size()),
       cones_knocked(model.cones.size()),

@@ -5,9 +5,11 @@
 
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <thread>
 
 #include "sim/runner/model.h"
+#include "sim/runner/sim_hal.h"
 #include "sim/runner/simulation.h"
 
 namespace paddock::runner {
@@ -170,6 +172,24 @@ TEST(Simulation, WithTheTrueStateTheSlamErrorIsExactlyZero) {
   EXPECT_EQ(r.slam.ate_rms, 0.0);
   EXPECT_EQ(r.slam.ate_max, 0.0);
   EXPECT_EQ(r.slam.heading_rms, 0.0);
+}
+
+TEST(Simulation, WithSlamOdometryTheTruthNeverCrossesTheHal) {
+  // the HAL of a run that is not slam = ground_truth refuses the true state
+  SimHal hal(false);
+  EXPECT_THROW(hal.post(hal::StateEstimate{}), std::logic_error);
+  EXPECT_NO_THROW(hal.post(hal::Imu{}));
+  // and such a run drives on its own estimate: it gets under way, and its
+  // dead-reckoned pose is off the truth, but not by much after 6 s
+  const ScenarioOnTrack& s = default_setup();
+  Scenario odo = s.scenario;
+  odo.autonomy.slam = stack::SlamMode::Odometry;
+  const RunResult r = run(odo, s.track);
+  ASSERT_FALSE(r.log.empty());
+  EXPECT_GT(std::hypot(r.log.back().x - r.log.front().x, r.log.back().y - r.log.front().y), 20.0);
+  EXPECT_GT(r.slam.samples, 1000);
+  EXPECT_GT(r.slam.ate_max, 0.0);
+  EXPECT_LT(r.slam.ate_max, 0.5);
 }
 
 TEST(Simulation, StreamSeedsDifferPerStream) {
