@@ -211,6 +211,134 @@ EkfStatus VelocityEkf::on_steering(const hal::SteeringAngle& m) {
   return EkfStatus::Ok;
 }
 
+bool VelocityEkf::at_rest(const hal::WheelSpeeds& m, double ax, double ay) {
+  // every wheel still and the IMU quiet for standstill_time (a car whose
+  // wheels have just stopped may still creep on its tyres' deflections)
+  const VelocityEkfParams& p = params_;
+  bool still = has_imu_;
+  for (double w : m.omega) still = still && std::abs(w) <= p.standstill_wheel_speed;
+  still = still && std::hypot(ax, ay) <= p.standstill_accel && std::abs(x_(kR)) <= p.standstill_yaw_rate;
+  if (!still) still_since_.reset();
+  else if (!still_since_) still_since_ = m.stamp;
+  return still && m.stamp - *still_since_ >= from_seconds(p.standstill_time);
+}
+
+void VelocityEkf::zero_velocity_update() {
+  const double var = params_.standstill_std * params_.standstill_std;
+  for (std::size_t k : {kVx, kVy, kR}) {
+    Vector H = Vector::Zero();
+    H(k) = 1.0;
+    update(-x_(k), H, var);
+  }
+  wheels_used_ = 4;
+  acquired_ = true;
+}
+
+VelocityEkf::WheelModel VelocityEkf::wheel_model(const hal::WheelSpeeds& m, double kappa) const {
+  const VelocityEkfParams& p = params_;
+  const double R = geometry_.wheel_radius;
+  const double r = x_(kR);
+  WheelModel w;
+  // the slip's error: one part common to the four wheels (the same force
+  // on the same tyres: what the model gets wrong, it gets wrong for all),
+  // one part each wheel's own (load transfer, brake balance)
+  const double common_sigma = p.slip_std + p.slip_model_error * std::abs(kappa);
+  // (in a corner the inner and outer tyres' combined slips differ: a
+  // left-right difference of 0.1 % at 1.5 g that would read as 0.01 rad/s
+  // of yaw rate for as long as the corner lasts)
+  const double own_sigma = p.wheel_slip_std + p.wheel_slip_model_error * std::abs(kappa) +
+                           p.wheel_slip_lateral * std::abs(r * x_(kVx));
+  // each wheel's model: predicted reading, Jacobian, slip sensitivity, the vx it implies
+  std::array<double, 4> slip{};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const double d = i < 2 ? steering_ : 0.0;
+    const double cd = std::cos(d), sd = std::sin(d);
+    const double px = wheel_x_[i], py = wheel_y_[i];
+    const double vy = x_(kVy), vx = x_(kVx);
+    const double u = (vx - r * py) * cd + (vy + r * px) * sd;
+    const double scale = std::max(std::abs(u), kSlipSpeedFloor);
+    const double h = (u + kappa * scale) / R;
+    // d h / d u: 1 + k sign(u) above the slip's speed floor
+    const double dh = 1.0 + (std::abs(u) > kSlipSpeedFloor ? std::copysign(kappa, u) : 0.0);
+    // the Jacobian leaves out the lateral term (vy + r px) sin d of the
+    // steered wheels: what it would observe, the front axle's lateral
+    // velocity, is drowned by the difference of the front and rear tyres'
+    // slips (0.1 % of 15 m/s reads as 0.13 m/s of it at 0.1 rad of
+    // steering) and would leak into vy, r and the gyro bias
+    w.H[i] = Vector::Zero();
+    w.H[i](kVx) = dh * cd / R;
+    w.H[i](kR) = -dh * py * cd / R;
+    w.nu[i] = m.omega[i] - h;
+    slip[i] = scale / R;  // rad/s per unit slip ratio
+    // the vx for which this wheel's reading is the prediction (cd > 0: |d| < pi/2)
+    w.implied[i] = vx + w.nu[i] * R / std::max(dh * cd, 0.1);
+  }
+  // the measurement covariance: encoder noise and own slip on the diagonal,
+  // the common slip fully correlated: C = c^2 s s^T
+  for (std::size_t i = 0; i < 4; ++i)
+    for (std::size_t j = 0; j < 4; ++j) w.C(i, j) = common_sigma * common_sigma * slip[i] * slip[j];
+  for (std::size_t i = 0; i < 4; ++i) w.C(i, i) += p.wheel_noise * p.wheel_noise + own_sigma * own_sigma * slip[i] * slip[i];
+  return w;
+}
+
+std::array<bool, 4> VelocityEkf::consistent_wheels(const WheelModel& w, double kappa) const {
+  const VelocityEkfParams& p = params_;
+  // the reference: the median, or under a driving (braking) force the slowest (fastest) wheel
+  std::array<double, 4> sorted = w.implied;
+  std::sort(sorted.begin(), sorted.end());
+  double reference = 0.5 * (sorted[1] + sorted[2]);
+  if (acquired_ && kappa > p.drive_threshold) reference = sorted[0];
+  if (acquired_ && kappa < -p.drive_threshold) reference = sorted[3];
+  const double tolerance = p.consistency_tolerance + p.consistency_relative * std::abs(reference);
+  std::array<bool, 4> use{};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const double S = w.H[i].dot(P_ * w.H[i]) + w.C(i, i);
+    use[i] = std::abs(w.implied[i] - reference) <= tolerance && (!acquired_ || w.nu[i] * w.nu[i] <= p.wheel_gate * S);
+  }
+  return use;
+}
+
+int VelocityEkf::wheel_update(WheelModel w, const std::array<bool, 4>& use) {
+  // the accepted wheels together (their slip errors are correlated): a
+  // fixed 4 x 4 update in which a rejected wheel is a row of zeros with a
+  // unit variance of its own (it then moves nothing)
+  Eigen::Matrix<double, 4, 9> Hu = Eigen::Matrix<double, 4, 9>::Zero();
+  Eigen::Vector4d nuu = Eigen::Vector4d::Zero();
+  int used = 0;
+  for (std::size_t i = 0; i < 4; ++i) {
+    if (!use[i]) continue;
+    ++used;
+    Hu.row(static_cast<Eigen::Index>(i)) = w.H[i].transpose();
+    nuu(static_cast<Eigen::Index>(i)) = w.nu[i];
+  }
+  for (std::size_t i = 0; i < 4; ++i)
+    for (std::size_t j = 0; j < 4; ++j)
+      if (!use[i] || !use[j]) w.C(i, j) = i == j ? 1.0 : 0.0;
+  if (used == 0) return 0;
+  const Eigen::Matrix<double, 9, 4> PHt = P_ * Hu.transpose();
+  const Eigen::Matrix4d S = Hu * PHt + w.C;
+  const Eigen::LLT<Eigen::Matrix4d> llt(S);
+  if (llt.info() != Eigen::Success) return used;
+  // K = P H^T S^-1; P - K S K^T = P - P H^T S^-1 H P
+  const Eigen::Matrix<double, 4, 9> SinvHP = llt.solve(PHt.transpose());
+  x_ += SinvHP.transpose() * nuu;
+  P_ -= PHt * SinvHP;
+  P_ = 0.5 * (P_ + P_.transpose()).eval();
+  x_(kYaw) = wrap_angle(x_(kYaw));
+  return used;
+}
+
+void VelocityEkf::rear_slip_update() {
+  // the rear axle's lateral slip: vy = -r vx^2 / (g C), the model's value
+  // taken as the measurement of vy alone (its Jacobian left out on purpose:
+  // the model's error must not leak into vx, r or the gyro bias)
+  const double model = -x_(kR) * x_(kVx) * x_(kVx) / (kGravity * geometry_.cornering_stiffness);
+  Vector Hy = Vector::Zero();
+  Hy(kVy) = 1.0;
+  const double sigma = params_.vy_std + params_.vy_relative * std::abs(model);
+  update(model - x_(kVy), Hy, sigma * sigma);
+}
+
 EkfStatus VelocityEkf::on_wheel_speeds(const hal::WheelSpeeds& m) {
   const VelocityEkfParams& p = params_;
   bool ok = true;
@@ -231,124 +359,18 @@ EkfStatus VelocityEkf::on_wheel_speeds(const hal::WheelSpeeds& m) {
   has_wheels_ = true;
   wheel_stamp_ = m.stamp;
 
-  const double R = geometry_.wheel_radius;
   const double r = x_(kR);
   const double ax = has_imu_ ? ax_m_ - x_(kBax) + r * r * geometry_.imu_x : 0.0;
   const double ay = has_imu_ ? ay_m_ - x_(kBay) : 0.0;
-
-  // standstill: every wheel still and the IMU quiet for standstill_time (a
-  // car whose wheels have just stopped may still creep on its tyres'
-  // deflections) -> a zero-velocity update
-  bool still = has_imu_;
-  for (double w : m.omega) still = still && std::abs(w) <= p.standstill_wheel_speed;
-  still = still && std::hypot(ax, ay) <= p.standstill_accel && std::abs(r) <= p.standstill_yaw_rate;
-  if (!still) still_since_.reset();
-  else if (!still_since_) still_since_ = m.stamp;
-  if (still && m.stamp - *still_since_ >= from_seconds(p.standstill_time)) {
-    const double var = p.standstill_std * p.standstill_std;
-    for (std::size_t k : {kVx, kVy, kR}) {
-      Vector H = Vector::Zero();
-      H(k) = 1.0;
-      update(-x_(k), H, var);
-    }
-    wheels_used_ = 4;
-    acquired_ = true;
+  if (at_rest(m, ax, ay)) {
+    zero_velocity_update();
   } else {
     const double kappa = modelled_slip();
-    // the slip's error: one part common to the four wheels (the same force
-    // on the same tyres: what the model gets wrong, it gets wrong for all),
-    // one part each wheel's own (load transfer, brake balance)
-    const double common_sigma = p.slip_std + p.slip_model_error * std::abs(kappa);
-    // (in a corner the inner and outer tyres' combined slips differ: a
-    // left-right difference of 0.1 % at 1.5 g that would read as 0.01 rad/s
-    // of yaw rate for as long as the corner lasts)
-    const double own_sigma = p.wheel_slip_std + p.wheel_slip_model_error * std::abs(kappa) +
-                             p.wheel_slip_lateral * std::abs(r * x_(kVx));
-    // each wheel's model: predicted reading, Jacobian, slip sensitivity, the vx it implies
-    std::array<Vector, 4> H;
-    std::array<double, 4> nu{}, slip{}, implied{};
-    for (std::size_t i = 0; i < 4; ++i) {
-      const double d = i < 2 ? steering_ : 0.0;
-      const double cd = std::cos(d), sd = std::sin(d);
-      const double px = wheel_x_[i], py = wheel_y_[i];
-      const double vy = x_(kVy), vx = x_(kVx);
-      const double u = (vx - r * py) * cd + (vy + r * px) * sd;
-      const double scale = std::max(std::abs(u), kSlipSpeedFloor);
-      const double h = (u + kappa * scale) / R;
-      // d h / d u: 1 + k sign(u) above the slip's speed floor
-      const double dh = 1.0 + (std::abs(u) > kSlipSpeedFloor ? std::copysign(kappa, u) : 0.0);
-      // the Jacobian leaves out the lateral term (vy + r px) sin d of the
-      // steered wheels: what it would observe, the front axle's lateral
-      // velocity, is drowned by the difference of the front and rear tyres'
-      // slips (0.1 % of 15 m/s reads as 0.13 m/s of it at 0.1 rad of
-      // steering) and would leak into vy, r and the gyro bias
-      H[i] = Vector::Zero();
-      H[i](kVx) = dh * cd / R;
-      H[i](kR) = -dh * py * cd / R;
-      nu[i] = m.omega[i] - h;
-      slip[i] = scale / R;  // rad/s per unit slip ratio
-      // the vx for which this wheel's reading is the prediction (cd > 0: |d| < pi/2)
-      implied[i] = vx + nu[i] * R / std::max(dh * cd, 0.1);
-    }
-    // the measurement covariance: encoder noise and own slip on the diagonal,
-    // the common slip fully correlated: C = c^2 s s^T
-    Eigen::Matrix4d C;
-    for (std::size_t i = 0; i < 4; ++i)
-      for (std::size_t j = 0; j < 4; ++j) C(i, j) = common_sigma * common_sigma * slip[i] * slip[j];
-    for (std::size_t i = 0; i < 4; ++i)
-      C(i, i) += p.wheel_noise * p.wheel_noise + own_sigma * own_sigma * slip[i] * slip[i];
-
-    // the reference: the median, or under a driving (braking) force the slowest (fastest) wheel
-    std::array<double, 4> sorted = implied;
-    std::sort(sorted.begin(), sorted.end());
-    double reference = 0.5 * (sorted[1] + sorted[2]);
-    if (acquired_ && kappa > p.drive_threshold) reference = sorted[0];
-    if (acquired_ && kappa < -p.drive_threshold) reference = sorted[3];
-    const double tolerance = p.consistency_tolerance + p.consistency_relative * std::abs(reference);
-    // the accepted wheels together (their slip errors are correlated): a
-    // fixed 4 x 4 update in which a rejected wheel is a row of zeros with a
-    // unit variance of its own (it then moves nothing)
-    Eigen::Matrix<double, 4, 9> Hu = Eigen::Matrix<double, 4, 9>::Zero();
-    Eigen::Vector4d nuu = Eigen::Vector4d::Zero();
-    std::array<bool, 4> use{};
-    int used = 0;
-    for (std::size_t i = 0; i < 4; ++i) {
-      const double S = H[i].dot(P_ * H[i]) + C(i, i);
-      use[i] = std::abs(implied[i] - reference) <= tolerance && (!acquired_ || nu[i] * nu[i] <= p.wheel_gate * S);
-      if (!use[i]) continue;
-      ++used;
-      Hu.row(static_cast<Eigen::Index>(i)) = H[i].transpose();
-      nuu(static_cast<Eigen::Index>(i)) = nu[i];
-    }
-    for (std::size_t i = 0; i < 4; ++i)
-      for (std::size_t j = 0; j < 4; ++j)
-        if (!use[i] || !use[j]) C(i, j) = i == j ? 1.0 : 0.0;
-    if (used > 0) {
-      const Eigen::Matrix<double, 9, 4> PHt = P_ * Hu.transpose();
-      const Eigen::Matrix4d S = Hu * PHt + C;
-      const Eigen::LLT<Eigen::Matrix4d> llt(S);
-      if (llt.info() == Eigen::Success) {
-        // K = P H^T S^-1; P - K S K^T = P - P H^T S^-1 H P
-        const Eigen::Matrix<double, 4, 9> SinvHP = llt.solve(PHt.transpose());
-        x_ += SinvHP.transpose() * nuu;
-        P_ -= PHt * SinvHP;
-        P_ = 0.5 * (P_ + P_.transpose()).eval();
-        x_(kYaw) = wrap_angle(x_(kYaw));
-      }
-    }
+    const WheelModel w = wheel_model(m, kappa);
+    const int used = wheel_update(w, consistent_wheels(w, kappa));
     wheels_used_ = used;
     if (used >= 2) acquired_ = true;
-
-    // the rear axle's lateral slip: vy = -r vx^2 / (g C), the model's value
-    // taken as the measurement of vy alone (its Jacobian left out on purpose:
-    // the model's error must not leak into vx, r or the gyro bias)
-    {
-      const double model = -x_(kR) * x_(kVx) * x_(kVx) / (kGravity * geometry_.cornering_stiffness);
-      Vector Hy = Vector::Zero();
-      Hy(kVy) = 1.0;
-      const double sigma = p.vy_std + p.vy_relative * std::abs(model);
-      update(model - x_(kVy), Hy, sigma * sigma);
-    }
+    rear_slip_update();
   }
   if (!state_finite()) {
     x_ = x0;

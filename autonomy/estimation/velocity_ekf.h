@@ -281,6 +281,23 @@ class VelocityEkf {
   bool state_finite() const;
   void start_if_needed(TimeNs stamp);
 
+  // the wheel update's parts: each wheel's predicted reading (innovation nu,
+  // Jacobian H, the vx its reading implies) and the readings' covariance C
+  struct WheelModel {
+    std::array<Vector, 4> H;
+    std::array<double, 4> nu{}, implied{};
+    Eigen::Matrix4d C;
+  };
+  // the car at rest for standstill_time (updates the timer)
+  bool at_rest(const hal::WheelSpeeds& m, double ax, double ay);
+  void zero_velocity_update();
+  WheelModel wheel_model(const hal::WheelSpeeds& m, double kappa) const;
+  // the wheels that neither spin nor lock: consistent with the others, inside the gate
+  std::array<bool, 4> consistent_wheels(const WheelModel& w, double kappa) const;
+  // the accepted wheels in one joint update; returns how many
+  int wheel_update(WheelModel w, const std::array<bool, 4>& use);
+  void rear_slip_update();
+
   VelocityEkfParams params_;
   CarGeometry geometry_;
   std::array<double, 4> wheel_x_{}, wheel_y_{};  // wheel positions in the base frame
