@@ -9,7 +9,6 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -412,29 +411,6 @@ TEST(VelocityEkfTest, SameSeedSameEstimates) {
     ASSERT_EQ(x.variance, y.variance);
     ASSERT_EQ(x.wheels_used, y.wheels_used);
   }
-}
-
-// an IMU predict and a wheel update take a few microseconds
-TEST(VelocityEkfTest, UpdatesAreFast) {
-  VelocityEkf ekf({}, CarGeometry{});
-  ekf.reset(Pose2{}, 0);
-  const int n = 20000;
-  const double w = 10.0 / 0.2;
-  const auto t0 = std::chrono::steady_clock::now();
-  for (int k = 1; k <= n; ++k) ekf.on_imu(hal::Imu{2 * k * 5'000'000LL, 0.2, 1.0, 0.1});
-  const auto t1 = std::chrono::steady_clock::now();
-  for (int k = 1; k <= n; ++k) {
-    ekf.on_imu(hal::Imu{(2 * n + 2 * k) * 5'000'000LL, 0.2, 1.0, 0.1});
-    ekf.on_wheel_speeds(hal::WheelSpeeds{(2 * n + 2 * k) * 5'000'000LL, {w + 0.3, w - 0.3, w + 0.3, w - 0.3}});
-  }
-  const auto t2 = std::chrono::steady_clock::now();
-  const double predict_us = std::chrono::duration<double, std::micro>(t1 - t0).count() / n;
-  const double update_us = std::chrono::duration<double, std::micro>(t2 - t1).count() / n - predict_us;
-  std::printf("timing: predict %.2f us, wheel update %.2f us\n", predict_us, update_us);
-  EXPECT_TRUE(finite(ekf.estimate().vx));
-  // generous bounds for a loaded CI machine (a few us on an idle one)
-  EXPECT_LT(predict_us, 50.0);
-  EXPECT_LT(update_us, 50.0);
 }
 
 }  // namespace
