@@ -38,7 +38,7 @@ namespace paddock::perception {
 struct OdometryParams {
   // dynamic rolling radius of the rear wheels (m): not a parameter of its
   // own, the runner fills it from the vehicle's ([vehicle] wheel_radius);
-  // the default is the default vehicle's (scenarios/vehicles/default.ini,
+  // the default is the gotthard car's (scenarios/vehicles/gotthard.ini,
   // FSSIM r_dyn)
   double wheel_radius = 0.231;
   // a LiDAR rotation (0.1 s) plus the scan's latency, with room to spare
