@@ -98,7 +98,8 @@ struct FastSlamParams {
   // noise exceeds the measurement noise (the paper's reason to adopt it)
   int version = 2;
   // 100: bench/fastslam_bench.cc, one update with ~20 observations on a map
-  // of ~150 landmarks; see the commit for the figures against 5 ms
+  // of 150 landmarks takes 1.2 ms on one core (resample 5 us, plus the
+  // blocks cloned on the next update's writes): a 4x margin to a 5 ms p99
   int particles = 100;
 
   // measurement noise: a cone's centre from perception, 2 cm + 1 % of the
