@@ -207,6 +207,8 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
     p.P.setZero();
   }
 
+  // the pose's rotation, once (at s^ here; at the sampled pose further down)
+  double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
   // the landmarks near enough to matter this frame (view, or an observation's reach)
   const double reach = std::max(pr.view_range, 0.0) + pr.search_radius;
   std::vector<int> near;
@@ -225,7 +227,8 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
   const double r2 = pr.search_radius * pr.search_radius;
   const Matrix2d assoc = pr.association_std * pr.association_std * Matrix2d::Identity();
   for (std::size_t k = 0; k < m; ++k) {
-    const Vec2 w = p.pose.transform(f.obs[k]->position);
+    const Vec2 o = f.obs[k]->position;
+    const Vec2 w{p.pose.x + cy * o.x - sy * o.y, p.pose.y + sy * o.x + cy * o.y};
     for (int i : near) {
       const Slot& s = p.slot(i);
       if (squared_norm(s.lm.mean - w) > r2) continue;
@@ -300,11 +303,17 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
   }
 
   // expectations and removal of the landmarks that were there before this frame
+  // (in view: |b| < view_range and |bearing| < view_half_fov <=> b_x > |b| cos(view_half_fov))
+  cy = std::cos(p.pose.yaw);
+  sy = std::sin(p.pose.yaw);
+  const double cos_fov = std::cos(pr.view_half_fov);
   for (int i : near) {
     const Slot& cs = p.slot(i);
     const bool seen = std::find(taken.begin(), taken.end(), i) != taken.end();
-    const Vec2 b = p.pose.inverse_transform(cs.lm.mean);
-    const bool in_view = squared_norm(b) < pr.view_range * pr.view_range && std::abs(angle_of(b)) < pr.view_half_fov;
+    const Vec2 d = cs.lm.mean - p.pose.position();
+    const Vec2 b{cy * d.x + sy * d.y, -sy * d.x + cy * d.y};
+    const double b2 = squared_norm(b);
+    const bool in_view = b2 < pr.view_range * pr.view_range && b.x > std::sqrt(b2) * cos_fov;
     if (!seen && !in_view) continue;
     Slot& s = p.mutable_slot(i);
     ++s.lm.expected;
@@ -322,7 +331,7 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
     log_lik += log_p0;
     Slot s;
     s.alive = true;
-    s.lm.mean = p.pose.transform(o.position);
+    s.lm.mean = {p.pose.x + cy * o.position.x - sy * o.position.y, p.pose.y + sy * o.position.x + cy * o.position.y};
     const Predicted h = predict_measurement(p.pose, s.lm.mean);
     const Matrix2d Hinv = h.Hm.inverse();
     s.lm.cov = Hinv * f.R[k] * Hinv.transpose();
