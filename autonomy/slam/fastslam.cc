@@ -214,7 +214,9 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
   std::vector<int> near;
   for (int i = 0; i < p.size; ++i) {
     const Slot& s = p.slot(i);
-    if (s.alive && squared_norm(s.lm.mean - p.pose.position()) < reach * reach) near.push_back(i);
+    const double d2 = squared_norm(s.lm.mean - p.pose.position());
+    // (one under the car has no stable bearing: neither scored nor expected)
+    if (s.alive && d2 < reach * reach && d2 > 0.25 * pr.min_range * pr.min_range) near.push_back(i);
   }
 
   // candidates: (log-likelihood, observation, landmark)
