@@ -211,13 +211,27 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
   double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
   // the landmarks near enough to matter this frame (view, or an observation's reach)
   const double reach = std::max(pr.view_range, 0.0) + pr.search_radius;
-  std::vector<int> near;
-  for (int i = 0; i < p.size; ++i) {
-    const Slot& s = p.slot(i);
-    const double d2 = squared_norm(s.lm.mean - p.pose.position());
-    // (one under the car has no stable bearing: neither scored nor expected)
-    if (s.alive && d2 < reach * reach && d2 > 0.25 * pr.min_range * pr.min_range) near.push_back(i);
+  // (their indices, and their positions in contiguous arrays for the search below)
+  std::vector<int>& near = near_;
+  near.clear();
+  near_x_.clear();
+  near_y_.clear();
+  const double under2 = 0.25 * pr.min_range * pr.min_range;
+  for (int b = 0; b * kLandmarkBlock < p.size; ++b) {
+    const Block& block = *p.blocks[static_cast<std::size_t>(b)];
+    const int n = std::min(kLandmarkBlock, p.size - b * kLandmarkBlock);
+    for (int j = 0; j < n; ++j) {
+      const Slot& s = block.slots[static_cast<std::size_t>(j)];
+      const double d2 = squared_norm(s.lm.mean - p.pose.position());
+      // (one under the car has no stable bearing: neither scored nor expected)
+      if (s.alive && d2 < reach * reach && d2 > under2) {
+        near.push_back(b * kLandmarkBlock + j);
+        near_x_.push_back(s.lm.mean.x);
+        near_y_.push_back(s.lm.mean.y);
+      }
+    }
   }
+  const std::size_t nn = near.size();
 
   // candidates: (log-likelihood, observation, landmark)
   struct Cand {
@@ -231,9 +245,11 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
   for (std::size_t k = 0; k < m; ++k) {
     const Vec2 o = f.obs[k]->position;
     const Vec2 w{p.pose.x + cy * o.x - sy * o.y, p.pose.y + sy * o.x + cy * o.y};
-    for (int i : near) {
+    for (std::size_t j = 0; j < nn; ++j) {
+      const double ex = near_x_[j] - w.x, ey = near_y_[j] - w.y;
+      if (ex * ex + ey * ey > r2) continue;
+      const int i = near[j];
       const Slot& s = p.slot(i);
-      if (squared_norm(s.lm.mean - w) > r2) continue;
       const Predicted h = predict_measurement(p.pose, s.lm.mean);
       Matrix2d Z = h.Hm * (s.lm.cov + assoc) * h.Hm.transpose() + f.R[k];
       if (v2) Z += h.Hs * p.P * h.Hs.transpose();

@@ -98,10 +98,10 @@ struct FastSlamParams {
   // noise exceeds the measurement noise (the paper's reason to adopt it)
   int version = 2;
   // 200: bench/fastslam_bench.cc, one update with ~20 observations on a map
-  // of 150 landmarks on one core: 100 particles 1.0 ms mean, 1.35 ms p99;
-  // 200: 2.0 ms, 3.1 ms p99; 300: 3.0 ms, 4.0 ms p99. 200 keeps a 1.6x
-  // margin to a 5 ms p99; more particles are more consistent (the noisy loop
-  // of tests/slam/fastslam_test.cc: NEES within its 95 % bound on 64 % of
+  // of 150 landmarks on one core: 200 particles 1.74 ms mean, 2.1-3.0 ms
+  // p99; 300: 2.65 ms, 3.1-3.6 ms p99. 200 keeps a 1.6x margin to a 5 ms
+  // p99; more particles are more consistent (the noisy loop of
+  // tests/slam/fastslam_test.cc: NEES within its 95 % bound on 64 % of
   // steps with 100, 73 % with 200, 81 % with 300)
   int particles = 200;
 
@@ -271,6 +271,9 @@ class FastSlam {
   double neff_ = 0.0;
   int resamples_ = 0;
   int rejected_ = 0;
+  // scratch of update_particle (kept to spare the allocations)
+  std::vector<int> near_;
+  std::vector<double> near_x_, near_y_;
 };
 
 }  // namespace paddock::slam
