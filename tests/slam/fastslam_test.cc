@@ -380,6 +380,32 @@ TEST(FastSlam, SameSeedSameResultBitForBit) {
   }
 }
 
+// ---- copy on write: particles (and copies of the filter) share landmark
+// blocks until one writes
+
+TEST(FastSlam, ACopyIsIndependentOfItsOriginal) {
+  const auto world = ring_world();
+  const Noise n = realistic();
+  FastSlam a(params_for(n, 2, 20), 8);
+  drive(a, world, n, 8, 40);
+  const FastSlam snapshot = a;  // shares every block with a
+  const auto before = snapshot.all_landmarks();
+  std::mt19937_64 rng(80);
+  for (int k = 41; k <= 60; ++k) {
+    a.predict(delta_of(true_pose((k - 1) * kStep), true_pose(k * kStep)));
+    a.update(observe(world, true_pose(k * kStep), n, rng));
+    a.resample();
+  }
+  const auto after = snapshot.all_landmarks();
+  ASSERT_EQ(after.size(), before.size());
+  for (std::size_t i = 0; i < after.size(); ++i) {
+    EXPECT_EQ(after[i].mean, before[i].mean);
+    EXPECT_EQ(after[i].sightings, before[i].sightings);
+    EXPECT_EQ(after[i].expected, before[i].expected);
+  }
+  EXPECT_NE(a.all_landmarks().size(), before.size());
+}
+
 // ---- colour votes
 
 TEST(FastSlam, ACameraVoteOutweighsALidarVote) {
