@@ -20,6 +20,9 @@ using Matrix23 = Eigen::Matrix<double, 2, 3>;
 
 constexpr double kLog2Pi = 1.8378770664093453;  // log(2 pi)
 
+// wrap_angle without its fmod for the angles already in [-pi, pi) (nearly all)
+double wrap(double a) { return a >= -kPi && a < kPi ? a : wrap_angle(a); }
+
 // h(s, m) and its Jacobians (see the header)
 struct Predicted {
   Vector2d z;
@@ -32,14 +35,14 @@ Predicted predict_measurement(const Pose2& s, Vec2 m) {
   const double q = std::max(dx * dx + dy * dy, 1e-12);
   const double r = std::sqrt(q);
   Predicted p;
-  p.z = {r, wrap_angle(std::atan2(dy, dx) - s.yaw)};
+  p.z = {r, wrap(std::atan2(dy, dx) - s.yaw)};
   p.Hm << dx / r, dy / r, -dy / q, dx / q;
   p.Hs << -dx / r, -dy / r, 0.0, dy / q, -dx / q, -1.0;
   return p;
 }
 
 Vector2d innovation(const Vector2d& z, const Vector2d& zhat) {
-  return {z(0) - zhat(0), wrap_angle(z(1) - zhat(1))};
+  return {z(0) - zhat(0), wrap(z(1) - zhat(1))};
 }
 
 // log N(nu; 0, S) and the squared Mahalanobis distance
@@ -51,9 +54,16 @@ double log_gauss(const Vector2d& nu, const Matrix2d& S, double* d2_out) {
   return -0.5 * d2 - kLog2Pi - 0.5 * std::log(det);
 }
 
+// the squared Mahalanobis distance alone (the gate, before any log)
+double mahalanobis2(const Vector2d& nu, const Matrix2d& S) {
+  // 2x2 inverse by hand: [d -b; -c a] / det
+  const double det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+  return (S(1, 1) * nu(0) * nu(0) - (S(0, 1) + S(1, 0)) * nu(0) * nu(1) + S(0, 0) * nu(1) * nu(1)) / det;
+}
+
 Pose2 compose(const Pose2& s, const Pose2& d) {
   const Vec2 p = s.transform({d.x, d.y});
-  return {p.x, p.y, wrap_angle(s.yaw + d.yaw)};
+  return {p.x, p.y, wrap(s.yaw + d.yaw)};
 }
 
 }  // namespace
@@ -147,7 +157,7 @@ Pose2 FastSlam::sample_pose(const Pose2& mean, const Matrix3d& cov) {
     const Vector3d sd = es.eigenvalues().cwiseMax(0.0).cwiseSqrt();
     d = es.eigenvectors() * sd.cwiseProduct(n);
   }
-  return {mean.x + d(0), mean.y + d(1), wrap_angle(mean.yaw + d(2))};
+  return {mean.x + d(0), mean.y + d(1), wrap(mean.yaw + d(2))};
 }
 
 void FastSlam::update(const std::vector<Observation>& obs) {
@@ -253,9 +263,10 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
       const Predicted h = predict_measurement(p.pose, s.lm.mean);
       Matrix2d Z = h.Hm * (s.lm.cov + assoc) * h.Hm.transpose() + f.R[k];
       if (v2) Z += h.Hs * p.P * h.Hs.transpose();
-      double d2 = 0.0;
-      const double l = log_gauss(innovation(f.z[k], h.z), Z, &d2);
-      if (d2 > pr.association_gate || !(l >= log_p0)) continue;
+      const Vector2d nu = innovation(f.z[k], h.z);
+      if (!(mahalanobis2(nu, Z) <= pr.association_gate)) continue;
+      const double l = log_gauss(nu, Z, nullptr);
+      if (!(l >= log_p0)) continue;
       cands.push_back({l, static_cast<int>(k), i});
     }
   }
@@ -289,7 +300,7 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
       log_lik += log_gauss(nu, Z, nullptr);
       const Eigen::Matrix<double, 3, 2> Ks = Sigma * h.Hs.transpose() * Z.inverse();
       mu += Ks * nu;
-      mu(2) = wrap_angle(mu(2));
+      mu(2) = wrap(mu(2));
       Sigma -= Ks * Z * Ks.transpose();
       Sigma = 0.5 * (Sigma + Sigma.transpose());
     }
