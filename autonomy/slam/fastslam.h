@@ -41,8 +41,9 @@
 // Data association, per particle, by maximum likelihood: an observation's
 // candidates are the landmarks within search_radius of where it lands (at
 // s^), scored with N(nu; 0, Z) (FastSLAM 1.0: at the sampled pose, without the
-// pose term), association_std^2 I added to the landmark's covariance; one past the Mahalanobis gate (nu^T Z^-1 nu > association_gate)
-// or below new_landmark_likelihood is no candidate. Mutual exclusion: the
+// pose term) with association_std^2 I added to the landmark's covariance; one
+// past the Mahalanobis gate (nu^T Z^-1 nu > association_gate) or below
+// new_landmark_likelihood is no candidate. Mutual exclusion: the
 // pairs are taken best first, each landmark and each observation once per
 // frame. An observation left without a landmark starts a tentative one; it is
 // confirmed after confirm_sightings sightings.
@@ -71,7 +72,9 @@
 // a resample copies ~N/16 pointers instead of N (fewer reference-count
 // updates, one allocation per touched block instead of one per landmark).
 // Not a balanced tree (log N sharing, Montemerlo's): a map of a few hundred
-// cones copies in well under a microsecond per particle as blocks.
+// cones is a few dozen blocks; a resample of 200 particles with 150
+// landmarks takes 9 us (bench/fastslam_bench.cc), the clones come later, on
+// the writes of the next update (counted in its time).
 // Removed landmarks stay as dead slots (indices never move).
 //
 // Bad input: a non-finite or too-near (< min_range) observation and a
@@ -82,7 +85,6 @@
 #include <cstdint>
 #include <memory>
 #include <random>
-#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -98,8 +100,8 @@ struct FastSlamParams {
   // noise exceeds the measurement noise (the paper's reason to adopt it)
   int version = 2;
   // 200: bench/fastslam_bench.cc, one update with ~20 observations on a map
-  // of 150 landmarks on one core: 200 particles 1.74 ms mean, 2.1-3.0 ms
-  // p99; 300: 2.65 ms, 3.1-3.6 ms p99. 200 keeps a 1.6x margin to a 5 ms
+  // of 150 landmarks on one core: 200 particles 1.7 ms mean, 2.1-2.9 ms
+  // p99; 300: 2.5 ms, 3.0-3.8 ms p99. 200 keeps a 1.6x margin to a 5 ms
   // p99; more particles are more consistent (the noisy loop of
   // tests/slam/fastslam_test.cc: NEES within its 95 % bound on 64 % of
   // steps with 100, 73 % with 200, 81 % with 300)
