@@ -19,6 +19,7 @@ using Eigen::Vector3d;
 using Matrix23 = Eigen::Matrix<double, 2, 3>;
 
 constexpr double kLog2Pi = 1.8378770664093453;  // log(2 pi)
+constexpr double kMaxDelta = 1000.0;             // m: more in one predict is no odometry
 
 // wrap_angle without its fmod for the angles already in [-pi, pi) (nearly all)
 double wrap(double a) { return a >= -kPi && a < kPi ? a : wrap_angle(a); }
@@ -118,7 +119,8 @@ void FastSlam::reset(const Pose2& pose) {
 }
 
 void FastSlam::predict(const Pose2& delta) {
-  if (!finite(delta)) {
+  // not odometry: a value that is not finite, or a jump no car makes between two frames
+  if (!finite(delta) || std::hypot(delta.x, delta.y) > kMaxDelta || std::abs(delta.yaw) > 2.0 * kPi) {
     ++rejected_;
     return;
   }

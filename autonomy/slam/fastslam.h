@@ -78,7 +78,8 @@
 // Removed landmarks stay as dead slots (indices never move).
 //
 // Bad input: a non-finite or too-near (< min_range) observation and a
-// non-finite delta are ignored and counted (rejected()), never a crash.
+// non-finite or absurd delta (over 1 km or 2 pi) are ignored and counted
+// (rejected()), never a crash.
 // Deterministic for a seed: its own std::mt19937_64, no global state.
 // Single-threaded (use_count() decides copy on write).
 #include <array>

@@ -445,8 +445,9 @@ TEST(FastSlam, BadInputIsIgnoredAndCounted) {
   slam.reset({1.0, 2.0, 0.5});
   slam.predict({nan, 0.0, 0.0});
   slam.predict({0.0, 0.0, INFINITY});
+  slam.predict({1e300, 0.0, 0.0});
   slam.update({{{nan, 1.0}}, {{1.0, INFINITY}}, {{0.0, 0.0}}});
-  EXPECT_EQ(slam.rejected(), 5);
+  EXPECT_EQ(slam.rejected(), 6);
   EXPECT_EQ(slam.pose().x, 1.0);
   EXPECT_EQ(slam.pose().y, 2.0);
   EXPECT_TRUE(slam.all_landmarks().empty());
