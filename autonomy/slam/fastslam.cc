@@ -1,0 +1,445 @@
+#include "autonomy/slam/fastslam.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
+
+namespace paddock::slam {
+
+namespace {
+
+using Eigen::Matrix2d;
+using Eigen::Matrix3d;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+using Matrix23 = Eigen::Matrix<double, 2, 3>;
+
+constexpr double kLog2Pi = 1.8378770664093453;  // log(2 pi)
+constexpr double kMaxDelta = 1000.0;             // m: more in one predict is no odometry
+
+// wrap_angle without its fmod for the angles already in [-pi, pi) (nearly all)
+double wrap(double a) { return a >= -kPi && a < kPi ? a : wrap_angle(a); }
+
+// h(s, m) and its Jacobians (see the header)
+struct Predicted {
+  Vector2d z;
+  Matrix2d Hm;
+  Matrix23 Hs;
+};
+
+Predicted predict_measurement(const Pose2& s, Vec2 m) {
+  const double dx = m.x - s.x, dy = m.y - s.y;
+  const double q = std::max(dx * dx + dy * dy, 1e-12);
+  const double r = std::sqrt(q);
+  Predicted p;
+  p.z = {r, wrap(std::atan2(dy, dx) - s.yaw)};
+  p.Hm << dx / r, dy / r, -dy / q, dx / q;
+  p.Hs << -dx / r, -dy / r, 0.0, dy / q, -dx / q, -1.0;
+  return p;
+}
+
+Vector2d innovation(const Vector2d& z, const Vector2d& zhat) {
+  return {z(0) - zhat(0), wrap(z(1) - zhat(1))};
+}
+
+// log N(nu; 0, S) and the squared Mahalanobis distance
+double log_gauss(const Vector2d& nu, const Matrix2d& S, double* d2_out) {
+  const double det = S.determinant();
+  const Vector2d Sinv_nu = S.inverse() * nu;
+  const double d2 = nu.dot(Sinv_nu);
+  if (d2_out) *d2_out = d2;
+  return -0.5 * d2 - kLog2Pi - 0.5 * std::log(det);
+}
+
+// the squared Mahalanobis distance alone (the gate, before any log)
+double mahalanobis2(const Vector2d& nu, const Matrix2d& S) {
+  // 2x2 inverse by hand: [d -b; -c a] / det
+  const double det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+  return (S(1, 1) * nu(0) * nu(0) - (S(0, 1) + S(1, 0)) * nu(0) * nu(1) + S(0, 0) * nu(1) * nu(1)) / det;
+}
+
+Pose2 compose(const Pose2& s, const Pose2& d) {
+  const Vec2 p = s.transform({d.x, d.y});
+  return {p.x, p.y, wrap(s.yaw + d.yaw)};
+}
+
+}  // namespace
+
+ConeColor Landmark::color() const {
+  int best = -1;
+  double best_votes = 0.0;
+  for (int c = 0; c < 5; ++c) {
+    if (static_cast<ConeColor>(c) == ConeColor::Unknown) continue;
+    if (votes[static_cast<std::size_t>(c)] > best_votes) {
+      best = c;
+      best_votes = votes[static_cast<std::size_t>(c)];
+    }
+  }
+  return best < 0 ? ConeColor::Unknown : static_cast<ConeColor>(best);
+}
+
+FastSlam::Slot& FastSlam::Particle::mutable_slot(int i) {
+  std::shared_ptr<Block>& b = blocks[i / kLandmarkBlock];
+  if (b.use_count() > 1) b = std::make_shared<Block>(*b);  // copy on write
+  return b->slots[i % kLandmarkBlock];
+}
+
+int FastSlam::Particle::add(const Slot& s) {
+  if (size % kLandmarkBlock == 0) blocks.push_back(std::make_shared<Block>());
+  const int i = size++;
+  mutable_slot(i) = s;
+  return i;
+}
+
+// the frame's valid observations as range, bearing and noise
+struct FastSlam::Frame {
+  std::vector<Vector2d> z;
+  std::vector<Matrix2d> R;
+  std::vector<const Observation*> obs;
+};
+
+FastSlam::FastSlam(const FastSlamParams& p, std::uint64_t seed)
+    : params_(params::require_valid(p, "FastSlamParams")), rng_(seed) {
+  reset(Pose2{});
+}
+
+void FastSlam::reset(const Pose2& pose) {
+  particles_.assign(static_cast<std::size_t>(params_.particles), Particle{});
+  const double w = 1.0 / params_.particles;
+  for (Particle& p : particles_) {
+    p.pose = {pose.x, pose.y, wrap_angle(pose.yaw)};
+    p.weight = w;
+  }
+  best_ = 0;
+  neff_ = params_.particles;
+}
+
+void FastSlam::predict(const Pose2& delta) {
+  // not odometry: a value that is not finite, or a jump no car makes between two frames
+  if (!finite(delta) || std::hypot(delta.x, delta.y) > kMaxDelta || std::abs(delta.yaw) > 2.0 * kPi) {
+    ++rejected_;
+    return;
+  }
+  // the odometry's noise on this step's delta (see the header)
+  const double dist = std::hypot(delta.x, delta.y);
+  const double sxy = params_.motion_std_xy_per_m * dist;
+  const double syaw = params_.motion_std_yaw_per_m * dist + params_.motion_std_yaw_per_rad * std::abs(delta.yaw);
+  const Vector3d q(sxy * sxy, sxy * sxy, syaw * syaw);
+  for (Particle& p : particles_) {
+    // P' = F P F^T + G Q G^T about the pre-step yaw
+    const double c = std::cos(p.pose.yaw), s = std::sin(p.pose.yaw);
+    const Vec2 rd{c * delta.x - s * delta.y, s * delta.x + c * delta.y};
+    Matrix3d F = Matrix3d::Identity();
+    F(0, 2) = -rd.y;
+    F(1, 2) = rd.x;
+    Matrix3d G = Matrix3d::Identity();
+    G(0, 0) = c;
+    G(0, 1) = -s;
+    G(1, 0) = s;
+    G(1, 1) = c;
+    p.P = F * p.P * F.transpose() + G * q.asDiagonal() * G.transpose();
+    p.pose = compose(p.pose, delta);
+  }
+}
+
+Pose2 FastSlam::sample_pose(const Pose2& mean, const Matrix3d& cov) {
+  std::normal_distribution<double> n01(0.0, 1.0);
+  const Vector3d n(n01(rng_), n01(rng_), n01(rng_));
+  Vector3d d;
+  Eigen::LLT<Matrix3d> llt(cov);
+  if (llt.info() == Eigen::Success) {
+    d = llt.matrixL() * n;
+  } else {
+    // positive semi-definite (exact odometry: zero): by its eigenvectors
+    Eigen::SelfAdjointEigenSolver<Matrix3d> es(cov);
+    const Vector3d sd = es.eigenvalues().cwiseMax(0.0).cwiseSqrt();
+    d = es.eigenvectors() * sd.cwiseProduct(n);
+  }
+  return {mean.x + d(0), mean.y + d(1), wrap(mean.yaw + d(2))};
+}
+
+void FastSlam::update(const std::vector<Observation>& obs) {
+  Frame f;
+  f.z.reserve(obs.size());
+  f.R.reserve(obs.size());
+  f.obs.reserve(obs.size());
+  for (const Observation& o : obs) {
+    const double r = norm(o.position);
+    if (!finite(o.position) || !(r >= params_.min_range)) {
+      ++rejected_;
+      continue;
+    }
+    const double sr = params_.range_std + params_.range_std_per_m * r;
+    f.z.emplace_back(r, angle_of(o.position));
+    f.R.push_back(Vector2d(sr * sr, params_.bearing_std * params_.bearing_std).asDiagonal());
+    f.obs.push_back(&o);
+  }
+
+  // each particle: sample its pose, associate, update its map; log-likelihoods
+  const std::size_t n = particles_.size();
+  std::vector<double> ll(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) update_particle(particles_[i], f, ll[i]);
+
+  // reweight (in logs, about the largest, against underflow) and normalise
+  const double top = *std::max_element(ll.begin(), ll.end());
+  double sum = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    particles_[i].weight *= std::exp(ll[i] - top);
+    sum += particles_[i].weight;
+  }
+  if (!(sum > 0.0) || !std::isfinite(sum)) {
+    // every weight underflowed: start again from equal weights
+    for (Particle& p : particles_) p.weight = 1.0 / static_cast<double>(n);
+  } else {
+    for (Particle& p : particles_) p.weight /= sum;
+  }
+  double sum2 = 0.0;
+  best_ = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sum2 += particles_[i].weight * particles_[i].weight;
+    if (particles_[i].weight > particles_[static_cast<std::size_t>(best_)].weight) best_ = static_cast<int>(i);
+  }
+  neff_ = 1.0 / sum2;
+  if (neff_ < params_.resample_neff_ratio * static_cast<double>(n)) resample();
+}
+
+void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
+  const FastSlamParams& pr = params_;
+  const bool v2 = pr.version == 2;
+  const std::size_t m = f.z.size();
+  const double log_p0 = std::log(pr.new_landmark_likelihood);
+
+  // FastSLAM 1.0: the pose from the motion model before anything else
+  if (!v2) {
+    p.pose = sample_pose(p.pose, p.P);
+    p.P.setZero();
+  }
+
+  // the pose's rotation, once (at s^ here; at the sampled pose further down)
+  double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
+  // the landmarks near enough to matter this frame (view, or an observation's reach)
+  const double reach = std::max(pr.view_range, 0.0) + pr.search_radius;
+  // (their indices, and their positions in contiguous arrays for the search below)
+  std::vector<int>& near = near_;
+  near.clear();
+  near_x_.clear();
+  near_y_.clear();
+  const double under2 = 0.25 * pr.min_range * pr.min_range;
+  for (int b = 0; b * kLandmarkBlock < p.size; ++b) {
+    const Block& block = *p.blocks[static_cast<std::size_t>(b)];
+    const int n = std::min(kLandmarkBlock, p.size - b * kLandmarkBlock);
+    for (int j = 0; j < n; ++j) {
+      const Slot& s = block.slots[static_cast<std::size_t>(j)];
+      const double d2 = squared_norm(s.lm.mean - p.pose.position());
+      // (one under the car has no stable bearing: neither scored nor expected)
+      if (s.alive && d2 < reach * reach && d2 > under2) {
+        near.push_back(b * kLandmarkBlock + j);
+        near_x_.push_back(s.lm.mean.x);
+        near_y_.push_back(s.lm.mean.y);
+      }
+    }
+  }
+  const std::size_t nn = near.size();
+
+  // candidates: (log-likelihood, observation, landmark)
+  struct Cand {
+    double ll;
+    int obs;
+    int lm;
+  };
+  std::vector<Cand> cands;
+  const double r2 = pr.search_radius * pr.search_radius;
+  const Matrix2d assoc = pr.association_std * pr.association_std * Matrix2d::Identity();
+  for (std::size_t k = 0; k < m; ++k) {
+    const Vec2 o = f.obs[k]->position;
+    const Vec2 w{p.pose.x + cy * o.x - sy * o.y, p.pose.y + sy * o.x + cy * o.y};
+    for (std::size_t j = 0; j < nn; ++j) {
+      const double ex = near_x_[j] - w.x, ey = near_y_[j] - w.y;
+      if (ex * ex + ey * ey > r2) continue;
+      const int i = near[j];
+      const Slot& s = p.slot(i);
+      const Predicted h = predict_measurement(p.pose, s.lm.mean);
+      Matrix2d Z = h.Hm * (s.lm.cov + assoc) * h.Hm.transpose() + f.R[k];
+      if (v2) Z += h.Hs * p.P * h.Hs.transpose();
+      const Vector2d nu = innovation(f.z[k], h.z);
+      if (!(mahalanobis2(nu, Z) <= pr.association_gate)) continue;
+      const double l = log_gauss(nu, Z, nullptr);
+      if (!(l >= log_p0)) continue;
+      cands.push_back({l, static_cast<int>(k), i});
+    }
+  }
+  // mutual exclusion, best first (ties: the earlier observation, then landmark)
+  std::sort(cands.begin(), cands.end(), [](const Cand& a, const Cand& b) {
+    if (a.ll != b.ll) return a.ll > b.ll;
+    if (a.obs != b.obs) return a.obs < b.obs;
+    return a.lm < b.lm;
+  });
+  std::vector<int> match(m, -1);
+  std::vector<int> taken;  // landmarks matched this frame
+  for (const Cand& c : cands) {
+    if (match[static_cast<std::size_t>(c.obs)] >= 0) continue;
+    if (std::find(taken.begin(), taken.end(), c.lm) != taken.end()) continue;
+    match[static_cast<std::size_t>(c.obs)] = c.lm;
+    taken.push_back(c.lm);
+  }
+
+  // FastSLAM 2.0: fold the associated observations into the pose's proposal,
+  // weigh by each one's likelihood given the ones before, then sample
+  if (v2) {
+    Vector3d mu(p.pose.x, p.pose.y, p.pose.yaw);
+    Matrix3d Sigma = p.P;
+    for (std::size_t k = 0; k < m; ++k) {
+      if (match[k] < 0) continue;
+      const Slot& s = p.slot(match[k]);
+      const Pose2 at{mu(0), mu(1), mu(2)};
+      const Predicted h = predict_measurement(at, s.lm.mean);
+      const Matrix2d Z = h.Hs * Sigma * h.Hs.transpose() + h.Hm * s.lm.cov * h.Hm.transpose() + f.R[k];
+      const Vector2d nu = innovation(f.z[k], h.z);
+      log_lik += log_gauss(nu, Z, nullptr);
+      const Eigen::Matrix<double, 3, 2> Ks = Sigma * h.Hs.transpose() * Z.inverse();
+      mu += Ks * nu;
+      mu(2) = wrap(mu(2));
+      Sigma -= Ks * Z * Ks.transpose();
+      Sigma = 0.5 * (Sigma + Sigma.transpose());
+    }
+    p.pose = sample_pose({mu(0), mu(1), mu(2)}, Sigma);
+    p.P.setZero();
+  }
+
+  // the landmarks' EKFs at the sampled pose
+  for (std::size_t k = 0; k < m; ++k) {
+    const Observation& o = *f.obs[k];
+    const double vote = o.colour_from_camera ? pr.camera_vote_weight : 1.0;
+    if (match[k] >= 0) {
+      Slot& s = p.mutable_slot(match[k]);
+      Landmark& lm = s.lm;
+      const Predicted h = predict_measurement(p.pose, lm.mean);
+      const Matrix2d S = h.Hm * lm.cov * h.Hm.transpose() + f.R[k];
+      const Vector2d nu = innovation(f.z[k], h.z);
+      if (!v2) log_lik += log_gauss(nu, S, nullptr);
+      const Matrix2d K = lm.cov * h.Hm.transpose() * S.inverse();
+      const Vector2d dm = K * nu;
+      lm.mean += Vec2{dm(0), dm(1)};
+      lm.cov = (Matrix2d::Identity() - K * h.Hm) * lm.cov;
+      lm.cov = 0.5 * (lm.cov + lm.cov.transpose());
+      ++lm.sightings;
+      lm.votes[static_cast<std::size_t>(o.color)] += vote;
+      if (lm.sightings >= pr.confirm_sightings) lm.confirmed = true;
+      s.misses = 0;
+    }
+  }
+
+  // expectations and removal of the landmarks that were there before this frame
+  // (in view: |b| < view_range and |bearing| < view_half_fov <=> b_x > |b| cos(view_half_fov))
+  cy = std::cos(p.pose.yaw);
+  sy = std::sin(p.pose.yaw);
+  const double cos_fov = std::cos(pr.view_half_fov);
+  for (int i : near) {
+    const Slot& cs = p.slot(i);
+    const bool seen = std::find(taken.begin(), taken.end(), i) != taken.end();
+    const Vec2 d = cs.lm.mean - p.pose.position();
+    const Vec2 b{cy * d.x + sy * d.y, -sy * d.x + cy * d.y};
+    const double b2 = squared_norm(b);
+    const bool in_view = b2 < pr.view_range * pr.view_range && b.x > std::sqrt(b2) * cos_fov;
+    if (!seen && !in_view) continue;
+    Slot& s = p.mutable_slot(i);
+    ++s.lm.expected;
+    if (!seen) ++s.misses;
+    const bool rare = s.lm.expected >= pr.remove_min_expected &&
+                      static_cast<double>(s.lm.sightings) < pr.remove_ratio * static_cast<double>(s.lm.expected);
+    const int misses = s.lm.confirmed ? pr.remove_misses : pr.remove_tentative_misses;
+    if (rare || s.misses >= misses) s.alive = false;
+  }
+
+  // observations without a landmark start tentative ones
+  for (std::size_t k = 0; k < m; ++k) {
+    if (match[k] >= 0) continue;
+    const Observation& o = *f.obs[k];
+    log_lik += log_p0;
+    Slot s;
+    s.alive = true;
+    s.lm.mean = {p.pose.x + cy * o.position.x - sy * o.position.y, p.pose.y + sy * o.position.x + cy * o.position.y};
+    const Predicted h = predict_measurement(p.pose, s.lm.mean);
+    const Matrix2d Hinv = h.Hm.inverse();
+    s.lm.cov = Hinv * f.R[k] * Hinv.transpose();
+    s.lm.sightings = 1;
+    s.lm.expected = 1;
+    s.lm.votes[static_cast<std::size_t>(o.color)] += o.colour_from_camera ? pr.camera_vote_weight : 1.0;
+    s.lm.confirmed = s.lm.sightings >= pr.confirm_sightings;
+    p.add(s);
+  }
+}
+
+void FastSlam::resample() {
+  // low variance: one uniform draw, N equally spaced pointers into the cumulative weights
+  const std::size_t n = particles_.size();
+  const double step = 1.0 / static_cast<double>(n);
+  std::uniform_real_distribution<double> u01(0.0, step);
+  const double r = u01(rng_);
+  std::vector<Particle> next;
+  next.reserve(n);
+  int new_best = -1;
+  double c = particles_[0].weight;
+  std::size_t i = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double u = r + static_cast<double>(k) * step;
+    while (u > c && i + 1 < n) c += particles_[++i].weight;
+    if (new_best < 0 && static_cast<int>(i) == best_) new_best = static_cast<int>(k);
+    next.push_back(particles_[i]);
+    next.back().weight = step;
+  }
+  if (new_best < 0) {
+    // the best particle always survives (its weight >= 1/N); keep it if rounding says otherwise
+    next[0] = particles_[static_cast<std::size_t>(best_)];
+    next[0].weight = step;
+    new_best = 0;
+  }
+  particles_ = std::move(next);
+  best_ = new_best;
+  ++resamples_;
+}
+
+Pose2 FastSlam::pose() const {
+  const Pose2& p = particles_[static_cast<std::size_t>(best_)].pose;
+  return p;
+}
+
+std::vector<Landmark> FastSlam::landmarks(bool confirmed_only) const {
+  const Particle& p = particles_[static_cast<std::size_t>(best_)];
+  std::vector<Landmark> out;
+  for (int i = 0; i < p.size; ++i) {
+    const Slot& s = p.slot(i);
+    if (s.alive && (s.lm.confirmed || !confirmed_only)) out.push_back(s.lm);
+  }
+  return out;
+}
+
+std::vector<Landmark> FastSlam::map() const { return landmarks(true); }
+std::vector<Landmark> FastSlam::all_landmarks() const { return landmarks(false); }
+
+Pose2 FastSlam::mean_pose() const {
+  const double ref = particles_[static_cast<std::size_t>(best_)].pose.yaw;
+  double x = 0.0, y = 0.0, dyaw = 0.0;
+  for (const Particle& p : particles_) {
+    x += p.weight * p.pose.x;
+    y += p.weight * p.pose.y;
+    dyaw += p.weight * wrap_angle(p.pose.yaw - ref);
+  }
+  return {x, y, wrap_angle(ref + dyaw)};
+}
+
+Matrix3d FastSlam::pose_covariance() const {
+  const Pose2 mean = mean_pose();
+  Matrix3d c = Matrix3d::Zero();
+  for (const Particle& p : particles_) {
+    const Vector3d e(p.pose.x - mean.x, p.pose.y - mean.y, wrap_angle(p.pose.yaw - mean.yaw));
+    c += p.weight * (p.P + e * e.transpose());
+  }
+  return c;
+}
+
+}  // namespace paddock::slam

@@ -1,0 +1,282 @@
+#pragma once
+// FastSLAM 1.0 and 2.0 (Montemerlo et al., AAAI 2002 and IJCAI 2003; the
+// paper's "State Estimation"): a particle filter over the base pose, each
+// particle carrying its own map of cones as independent 2x2 EKFs.
+//
+// Motion (predict): the odometry's pose change d = (dx, dy, dyaw) in the
+// previous base frame, with noise n ~ N(0, Q) added to it,
+//   Q = diag(sxy^2, sxy^2, syaw^2),  sxy = motion_std_xy_per_m |d_xy|,
+//   syaw = motion_std_yaw_per_m |d_xy| + motion_std_yaw_per_rad |dyaw|
+// (a per-call model: predict is meant to get one frame's motion). Each
+// particle keeps the predicted mean s^ = s (+) d and the covariance P of its
+// pose since the last update, P' = F P F^T + G Q G^T, F = d(s (+) d)/ds,
+// G = blockdiag(R(yaw), 1). The pose is sampled at the update: FastSLAM 1.0
+// draws it from N(s^, P) (the motion model), FastSLAM 2.0 from the proposal
+// that folds the frame's associated observations in.
+//
+// Measurement: an observation at (px, py) in the base frame is a range and
+// bearing z = (|p|, atan2(py, px)) with R = diag(sr^2, sb^2), sr = range_std
+// + range_std_per_m r, sb = bearing_std. For a landmark m seen from pose
+// s = (x, y, yaw), with d = m - (x, y), q = |d|^2:
+//   h(s, m) = (sqrt(q), atan2(d_y, d_x) - yaw)
+//   H_m = dh/dm = [ d_x/sqrt(q)  d_y/sqrt(q) ]    H_s = dh/ds = [ -d_x/sqrt(q) -d_y/sqrt(q)  0 ]
+//                 [ -d_y/q       d_x/q       ]                  [  d_y/q       -d_x/q       -1 ]
+// Landmark EKF: S = H_m C H_m^T + R, K = C H_m^T S^-1, m += K nu, C = (I - K H_m) C
+// (nu = z - h, bearing wrapped). A new landmark: m = s (+) p, C = H_m^-1 R H_m^-T.
+//
+// FastSLAM 2.0 proposal (Montemerlo 2003, eqs. for Sigma_s and mu_s), for the
+// frame's associated observations in turn, starting from (mu, Sigma) = (s^, P):
+//   Z = H_s Sigma H_s^T + H_m C H_m^T + R             (h, H at mu)
+//   Sigma_s = (H_s^T (H_m C H_m^T + R)^-1 H_s + Sigma^-1)^-1 = Sigma - K_s Z K_s^T,  K_s = Sigma H_s^T Z^-1
+//   mu_s = mu + Sigma_s H_s^T (H_m C H_m^T + R)^-1 nu = mu + K_s nu
+// (the Kalman form of the same equations: it needs no inverse of Sigma, which
+// is singular when the odometry is exact). The pose is then drawn from
+// N(mu_s, Sigma_s) and the landmarks updated at it. The importance weight is
+// the measurement likelihood under the pose-and-landmark linearisation,
+//   w *= N(nu; 0, Z)  for each associated observation (Z and nu at the mu
+//   before it: the sequential factorisation p(z_1..z_n) = prod p(z_k | z_<k)),
+// and FastSLAM 1.0's w *= N(nu; 0, H_m C H_m^T + R) at the sampled pose. An
+// observation that starts a landmark weighs new_landmark_likelihood (p0).
+//
+// Data association, per particle, by maximum likelihood: an observation's
+// candidates are the landmarks within search_radius of where it lands (at
+// s^), scored with N(nu; 0, Z) (FastSLAM 1.0: at the sampled pose, without the
+// pose term) with association_std^2 I added to the landmark's covariance; one
+// past the Mahalanobis gate (nu^T Z^-1 nu > association_gate) or below
+// new_landmark_likelihood is no candidate. Mutual exclusion: the
+// pairs are taken best first, each landmark and each observation once per
+// frame. An observation left without a landmark starts a tentative one; it is
+// confirmed after confirm_sightings sightings.
+//
+// Removal: a landmark is expected in a frame when it lies within view_range
+// and view_half_fov of the particle's pose (or was seen). It is removed when,
+// after remove_min_expected expectations, its sightings are below remove_ratio
+// times them (ghosts), or after remove_misses expected frames in a row
+// without a sighting (a cone that is gone: its long history of sightings
+// would keep a ratio up for laps), a tentative one after
+// remove_tentative_misses.
+//
+// Colour: each sighting votes for its colour, weight 1 (LiDAR intensity) or
+// camera_vote_weight (camera); the colour is the most voted one.
+//
+// Resampling: low variance (Thrun et al., Probabilistic Robotics, table 4.4)
+// when N_eff = 1 / sum w^2 < resample_neff_ratio N. pose() and map() are the
+// highest-weight particle's (chosen before resampling, as the paper says).
+//
+// Map storage, copy on write: a particle's landmarks live in blocks of
+// kLandmarkBlock held by std::shared_ptr; copying a particle (resampling)
+// copies the block pointers only, and a write clones a block that another
+// particle also holds (use_count() > 1). Blocks and not one pointer per
+// landmark: landmarks are created in the order the car meets them, so the
+// ones a frame touches (those in view) sit in a few neighbouring blocks, and
+// a resample copies ~N/16 pointers instead of N (fewer reference-count
+// updates, one allocation per touched block instead of one per landmark).
+// Not a balanced tree (log N sharing, Montemerlo's): a map of a few hundred
+// cones is a few dozen blocks; a resample of 200 particles with 150
+// landmarks takes 9 us (bench/fastslam_bench.cc), the clones come later, on
+// the writes of the next update (counted in its time).
+// Removed landmarks stay as dead slots (indices never move).
+//
+// Bad input: a non-finite or too-near (< min_range) observation and a
+// non-finite or absurd delta (over 1 km or 2 pi) are ignored and counted
+// (rejected()), never a crash.
+// Deterministic for a seed: its own std::mt19937_64, no global state.
+// Single-threaded (use_count() decides copy on write).
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "autonomy/common/cone.h"
+#include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
+
+namespace paddock::slam {
+
+struct FastSlamParams {
+  // 2: the proposal folds the measurements in, which pays where the motion
+  // noise exceeds the measurement noise (the paper's reason to adopt it)
+  int version = 2;
+  // 200: bench/fastslam_bench.cc, one update with ~20 observations on a map
+  // of 150 landmarks on one core: 200 particles 1.7 ms mean, 2.1-2.9 ms
+  // p99; 300: 2.5 ms, 3.0-3.8 ms p99. 200 keeps a 1.6x margin to a 5 ms
+  // p99; more particles are more consistent (the noisy loop of
+  // tests/slam/fastslam_test.cc: NEES within its 95 % bound on 64 % of
+  // steps with 100, 73 % with 200, 81 % with 300)
+  int particles = 200;
+
+  // measurement noise: a cone's centre from perception, 2 cm + 1 % of the
+  // range and 0.2 deg (the object-level sensor is 2 cm + 0.2 %, 0.11 deg:
+  // raw perception adds the centroid's bias from the cone's visible side)
+  double range_std = 0.02;
+  double range_std_per_m = 0.01;
+  double bearing_std = 0.2 * kPi / 180.0;
+
+  // odometry noise per predict (one frame's motion): the velocity EKF's
+  // wheel odometry drifts ~1 % of the distance; its gyro-integrated yaw by
+  // the gyro bias it leaves (~1e-3 rad/s, sim/sensors/imu.h's turn-on
+  // residual: 1e-4 rad per m at 10 m/s) and a MEMS gyro's scale error (0.5 %
+  // of the angle turned); the gyro's white noise is far below both
+  double motion_std_xy_per_m = 0.01;
+  double motion_std_yaw_per_m = 1e-4;
+  double motion_std_yaw_per_rad = 0.005;
+
+  // data association
+  // p0 (1/(m rad)): the density of a (range, bearing) innovation below which a
+  // new landmark is the likelier explanation; at the default noise a match at
+  // 10 m peaks near 400, so 1e-2 sits ~4.5 sigma out
+  double new_landmark_likelihood = 1e-2;
+  // chi-square, 2 dof: 16 (p = 3e-4): a cone 0.4 m from another is > 8 sigma away
+  double association_gate = 16.0;
+  // association only: this much std (each axis) is added to a landmark's
+  // position when scoring it, for the drift a particle does not know about
+  // (its pose relative to landmarks mapped a loop ago: the particle cloud's
+  // spread shrinks with resampling, the true drift does not); it lets a loop
+  // close after ~1 m of drift with cones >= 2 m apart
+  double association_std = 0.3;
+  // a cheap first gate: only landmarks this close to where the observation
+  // lands are scored (well above the pose's drift over one frame)
+  double search_radius = 2.0;
+  // observations nearer than this have no stable bearing
+  double min_range = 0.3;
+
+  // a real cone is seen in most frames while the car approaches it; a ghost
+  // of a good pipeline rarely repeats at one place (as ConeMapParams)
+  int confirm_sightings = 5;
+
+  // where a cone is expected to be seen: inside perception's reliable range
+  // (the object sensor's 20 m) and field of view (180 deg), with a margin
+  double view_range = 18.0;
+  double view_half_fov = 80.0 * kPi / 180.0;
+  // removal: seen in fewer than remove_ratio of the frames it was expected
+  // in (after remove_min_expected of them), or not seen in remove_misses
+  // expected frames in a row
+  double remove_ratio = 0.3;
+  int remove_min_expected = 5;
+  int remove_misses = 10;
+  // a tentative landmark goes after this many expected frames in a row
+  // without a sighting (a ghost passes out of view in a few frames)
+  int remove_tentative_misses = 3;
+
+  // resample when N_eff < ratio N (the usual half)
+  double resample_neff_ratio = 0.5;
+  // a camera colour vote outweighs a LiDAR intensity vote
+  double camera_vote_weight = 3.0;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(version), {"", params::in(1, 2), "1: FastSLAM 1.0 (motion-model proposal), 2: FastSLAM 2.0 (proposal folds the measurements in)"});
+    v(PADDOCK_PARAM(particles), {"", params::in(1, 100000), "number of particles"});
+    v(PADDOCK_PARAM(range_std), {"m", params::above_up_to(0.0, 10.0), "range noise std of an observation (constant part)"});
+    v(PADDOCK_PARAM(range_std_per_m), {"", params::in(0.0, 1.0), "range noise std per m of range"});
+    v(PADDOCK_PARAM(bearing_std), {"rad", params::above_up_to(0.0, 1.0), "bearing noise std of an observation"});
+    v(PADDOCK_PARAM(motion_std_xy_per_m), {"", params::in(0.0, 1.0), "odometry position noise std per m travelled (per predict)"});
+    v(PADDOCK_PARAM(motion_std_yaw_per_m), {"rad/m", params::in(0.0, 1.0), "odometry yaw noise std per m travelled (per predict)"});
+    v(PADDOCK_PARAM(motion_std_yaw_per_rad), {"", params::in(0.0, 1.0), "odometry yaw noise std per rad turned (per predict)"});
+    v(PADDOCK_PARAM(new_landmark_likelihood), {"1/(m rad)", params::above(0.0), "innovation density below which an observation starts a new landmark (p0)"});
+    v(PADDOCK_PARAM(association_gate), {"", params::above(0.0), "chi-square (2 dof) Mahalanobis gate of an association"});
+    v(PADDOCK_PARAM(association_std), {"m", params::in(0.0, 10.0), "std added to a landmark's position when scoring an association (unmodelled drift)"});
+    v(PADDOCK_PARAM(search_radius), {"m", params::above_up_to(0.0, 100.0), "only landmarks this close to an observation are scored"});
+    v(PADDOCK_PARAM(min_range), {"m", params::above_up_to(0.0, 10.0), "nearer observations are rejected"});
+    v(PADDOCK_PARAM(confirm_sightings), {"", params::in(1, 100000), "sightings before a landmark is confirmed"});
+    v(PADDOCK_PARAM(view_range), {"m", params::above_up_to(0.0, 1000.0), "a landmark nearer than this (and in view_half_fov) is expected to be seen"});
+    v(PADDOCK_PARAM(view_half_fov), {"rad", params::above_up_to(0.0, kPi), "half the field of view in which a landmark is expected to be seen"});
+    v(PADDOCK_PARAM(remove_ratio), {"", params::fraction(), "removed when seen in fewer than this share of the frames it was expected in"});
+    v(PADDOCK_PARAM(remove_min_expected), {"", params::in(1, 100000), "expected frames before remove_ratio applies"});
+    v(PADDOCK_PARAM(remove_misses), {"", params::in(1, 100000), "removed after this many expected frames in a row without a sighting"});
+    v(PADDOCK_PARAM(remove_tentative_misses), {"", params::in(1, 100000), "a tentative landmark is removed after this many expected frames in a row without a sighting"});
+    v(PADDOCK_PARAM(resample_neff_ratio), {"", params::fraction(), "resample when N_eff < ratio * particles"});
+    v(PADDOCK_PARAM(camera_vote_weight), {"", params::above_up_to(0.0, 1000.0), "weight of a camera colour vote (a LiDAR vote weighs 1)"});
+  }
+};
+
+// one cone of one frame
+struct Observation {
+  Vec2 position;  // base frame, m
+  ConeColor color = ConeColor::Unknown;
+  bool colour_from_camera = false;
+};
+
+struct Landmark {
+  Vec2 mean;                               // map frame, m
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();  // m^2
+  int sightings = 0;                       // frames it was associated in
+  int expected = 0;                        // frames it was in view (or seen)
+  std::array<double, 5> votes{};           // per ConeColor, in enum order
+  bool confirmed = false;
+  ConeColor color() const;                 // the most voted colour; unknown when no coloured vote
+};
+
+class FastSlam {
+ public:
+  static constexpr int kLandmarkBlock = 16;
+
+  // throws std::invalid_argument on invalid params
+  FastSlam(const FastSlamParams& p, std::uint64_t seed);
+
+  // every particle at pose, with an empty map
+  void reset(const Pose2& pose);
+  // the motion since the last call, as the odometry measured it: the base's
+  // pose change in the previous base frame
+  void predict(const Pose2& delta);
+  // one frame of cone observations (base frame, at the pose after the last predict)
+  void update(const std::vector<Observation>& obs);
+
+  // the highest-weight particle's pose
+  Pose2 pose() const;
+  // its confirmed landmarks
+  std::vector<Landmark> map() const;
+  // all its landmarks, tentative ones too
+  std::vector<Landmark> all_landmarks() const;
+  // the particle set's weighted mean and covariance (x, y, yaw) (for
+  // consistency checks; yaw averaged about the best particle's)
+  Pose2 mean_pose() const;
+  Eigen::Matrix3d pose_covariance() const;
+
+  double effective_particles() const { return neff_; }  // N_eff after the last update
+  int resamples() const { return resamples_; }
+  int rejected() const { return rejected_; }  // ignored observations and deltas
+  // low-variance resampling now (update() does it when N_eff is low)
+  void resample();
+
+ private:
+  struct Slot {
+    Landmark lm;
+    int misses = 0;  // expected frames in a row without a sighting
+    bool alive = false;
+  };
+  struct Block {
+    std::array<Slot, kLandmarkBlock> slots;
+  };
+  struct Particle {
+    Pose2 pose;                                 // s^ until the update samples it
+    Eigen::Matrix3d P = Eigen::Matrix3d::Zero();  // pose covariance since the last update
+    double weight = 1.0;
+    std::vector<std::shared_ptr<Block>> blocks;  // shared between particles until written
+    int size = 0;                                // slots used
+    const Slot& slot(int i) const { return blocks[i / kLandmarkBlock]->slots[i % kLandmarkBlock]; }
+    Slot& mutable_slot(int i);                   // clones a shared block first
+    int add(const Slot& s);
+  };
+  struct Frame;  // an update's prepared observations
+
+  void update_particle(Particle& p, const Frame& f, double& log_lik);
+  Pose2 sample_pose(const Pose2& mean, const Eigen::Matrix3d& cov);
+  std::vector<Landmark> landmarks(bool confirmed_only) const;
+
+  FastSlamParams params_;
+  std::mt19937_64 rng_;
+  std::vector<Particle> particles_;
+  int best_ = 0;
+  double neff_ = 0.0;
+  int resamples_ = 0;
+  int rejected_ = 0;
+  // scratch of update_particle (kept to spare the allocations)
+  std::vector<int> near_;
+  std::vector<double> near_x_, near_y_;
+};
+
+}  // namespace paddock::slam
