@@ -207,25 +207,13 @@ void FastSlam::update(const std::vector<Observation>& obs) {
   if (neff_ < params_.resample_neff_ratio * static_cast<double>(n)) resample();
 }
 
-void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
+void FastSlam::gather_near(const Particle& p) {
+  // the landmarks near enough to matter this frame (view, or an
+  // observation's reach): their indices, and their positions in contiguous
+  // arrays for the association's search
   const FastSlamParams& pr = params_;
-  const bool v2 = pr.version == 2;
-  const std::size_t m = f.z.size();
-  const double log_p0 = std::log(pr.new_landmark_likelihood);
-
-  // FastSLAM 1.0: the pose from the motion model before anything else
-  if (!v2) {
-    p.pose = sample_pose(p.pose, p.P);
-    p.P.setZero();
-  }
-
-  // the pose's rotation, once (at s^ here; at the sampled pose further down)
-  double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
-  // the landmarks near enough to matter this frame (view, or an observation's reach)
   const double reach = std::max(pr.view_range, 0.0) + pr.search_radius;
-  // (their indices, and their positions in contiguous arrays for the search below)
-  std::vector<int>& near = near_;
-  near.clear();
+  near_.clear();
   near_x_.clear();
   near_y_.clear();
   const double under2 = 0.25 * pr.min_range * pr.min_range;
@@ -237,14 +225,23 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
       const double d2 = squared_norm(s.lm.mean - p.pose.position());
       // (one under the car has no stable bearing: neither scored nor expected)
       if (s.alive && d2 < reach * reach && d2 > under2) {
-        near.push_back(b * kLandmarkBlock + j);
+        near_.push_back(b * kLandmarkBlock + j);
         near_x_.push_back(s.lm.mean.x);
         near_y_.push_back(s.lm.mean.y);
       }
     }
   }
-  const std::size_t nn = near.size();
+}
 
+std::vector<int> FastSlam::associate(const Particle& p, const Frame& f, std::vector<int>& taken) const {
+  // maximum likelihood per observation, within the gate and above the
+  // new-landmark likelihood, one observation per landmark (mutual exclusion)
+  const FastSlamParams& pr = params_;
+  const bool v2 = pr.version == 2;
+  const std::size_t m = f.z.size();
+  const double log_p0 = std::log(pr.new_landmark_likelihood);
+  // the pose's rotation (at s^ for 2.0, at the sampled pose for 1.0)
+  const double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
   // candidates: (log-likelihood, observation, landmark)
   struct Cand {
     double ll;
@@ -257,10 +254,10 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
   for (std::size_t k = 0; k < m; ++k) {
     const Vec2 o = f.obs[k]->position;
     const Vec2 w{p.pose.x + cy * o.x - sy * o.y, p.pose.y + sy * o.x + cy * o.y};
-    for (std::size_t j = 0; j < nn; ++j) {
+    for (std::size_t j = 0; j < near_.size(); ++j) {
       const double ex = near_x_[j] - w.x, ey = near_y_[j] - w.y;
       if (ex * ex + ey * ey > r2) continue;
-      const int i = near[j];
+      const int i = near_[j];
       const Slot& s = p.slot(i);
       const Predicted h = predict_measurement(p.pose, s.lm.mean);
       Matrix2d Z = h.Hm * (s.lm.cov + assoc) * h.Hm.transpose() + f.R[k];
@@ -279,66 +276,70 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
     return a.lm < b.lm;
   });
   std::vector<int> match(m, -1);
-  std::vector<int> taken;  // landmarks matched this frame
+  taken.clear();
   for (const Cand& c : cands) {
     if (match[static_cast<std::size_t>(c.obs)] >= 0) continue;
     if (std::find(taken.begin(), taken.end(), c.lm) != taken.end()) continue;
     match[static_cast<std::size_t>(c.obs)] = c.lm;
     taken.push_back(c.lm);
   }
+  return match;
+}
 
+void FastSlam::propose_and_sample(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik) {
   // FastSLAM 2.0: fold the associated observations into the pose's proposal,
   // weigh by each one's likelihood given the ones before, then sample
-  if (v2) {
-    Vector3d mu(p.pose.x, p.pose.y, p.pose.yaw);
-    Matrix3d Sigma = p.P;
-    for (std::size_t k = 0; k < m; ++k) {
-      if (match[k] < 0) continue;
-      const Slot& s = p.slot(match[k]);
-      const Pose2 at{mu(0), mu(1), mu(2)};
-      const Predicted h = predict_measurement(at, s.lm.mean);
-      const Matrix2d Z = h.Hs * Sigma * h.Hs.transpose() + h.Hm * s.lm.cov * h.Hm.transpose() + f.R[k];
-      const Vector2d nu = innovation(f.z[k], h.z);
-      log_lik += log_gauss(nu, Z, nullptr);
-      const Eigen::Matrix<double, 3, 2> Ks = Sigma * h.Hs.transpose() * Z.inverse();
-      mu += Ks * nu;
-      mu(2) = wrap(mu(2));
-      Sigma -= Ks * Z * Ks.transpose();
-      Sigma = 0.5 * (Sigma + Sigma.transpose());
-    }
-    p.pose = sample_pose({mu(0), mu(1), mu(2)}, Sigma);
-    p.P.setZero();
+  Vector3d mu(p.pose.x, p.pose.y, p.pose.yaw);
+  Matrix3d Sigma = p.P;
+  for (std::size_t k = 0; k < f.z.size(); ++k) {
+    if (match[k] < 0) continue;
+    const Slot& s = p.slot(match[k]);
+    const Pose2 at{mu(0), mu(1), mu(2)};
+    const Predicted h = predict_measurement(at, s.lm.mean);
+    const Matrix2d Z = h.Hs * Sigma * h.Hs.transpose() + h.Hm * s.lm.cov * h.Hm.transpose() + f.R[k];
+    const Vector2d nu = innovation(f.z[k], h.z);
+    log_lik += log_gauss(nu, Z, nullptr);
+    const Eigen::Matrix<double, 3, 2> Ks = Sigma * h.Hs.transpose() * Z.inverse();
+    mu += Ks * nu;
+    mu(2) = wrap(mu(2));
+    Sigma -= Ks * Z * Ks.transpose();
+    Sigma = 0.5 * (Sigma + Sigma.transpose());
   }
+  p.pose = sample_pose({mu(0), mu(1), mu(2)}, Sigma);
+  p.P.setZero();
+}
 
-  // the landmarks' EKFs at the sampled pose
-  for (std::size_t k = 0; k < m; ++k) {
+void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik) {
+  // the associated landmarks' EKFs at the sampled pose (1.0 weighs here)
+  const FastSlamParams& pr = params_;
+  for (std::size_t k = 0; k < f.z.size(); ++k) {
+    if (match[k] < 0) continue;
     const Observation& o = *f.obs[k];
-    const double vote = o.colour_from_camera ? pr.camera_vote_weight : 1.0;
-    if (match[k] >= 0) {
-      Slot& s = p.mutable_slot(match[k]);
-      Landmark& lm = s.lm;
-      const Predicted h = predict_measurement(p.pose, lm.mean);
-      const Matrix2d S = h.Hm * lm.cov * h.Hm.transpose() + f.R[k];
-      const Vector2d nu = innovation(f.z[k], h.z);
-      if (!v2) log_lik += log_gauss(nu, S, nullptr);
-      const Matrix2d K = lm.cov * h.Hm.transpose() * S.inverse();
-      const Vector2d dm = K * nu;
-      lm.mean += Vec2{dm(0), dm(1)};
-      lm.cov = (Matrix2d::Identity() - K * h.Hm) * lm.cov;
-      lm.cov = 0.5 * (lm.cov + lm.cov.transpose());
-      ++lm.sightings;
-      lm.votes[static_cast<std::size_t>(o.color)] += vote;
-      if (lm.sightings >= pr.confirm_sightings) lm.confirmed = true;
-      s.misses = 0;
-    }
+    Slot& s = p.mutable_slot(match[k]);
+    Landmark& lm = s.lm;
+    const Predicted h = predict_measurement(p.pose, lm.mean);
+    const Matrix2d S = h.Hm * lm.cov * h.Hm.transpose() + f.R[k];
+    const Vector2d nu = innovation(f.z[k], h.z);
+    if (pr.version != 2) log_lik += log_gauss(nu, S, nullptr);
+    const Matrix2d K = lm.cov * h.Hm.transpose() * S.inverse();
+    const Vector2d dm = K * nu;
+    lm.mean += Vec2{dm(0), dm(1)};
+    lm.cov = (Matrix2d::Identity() - K * h.Hm) * lm.cov;
+    lm.cov = 0.5 * (lm.cov + lm.cov.transpose());
+    ++lm.sightings;
+    lm.votes[static_cast<std::size_t>(o.color)] += o.colour_from_camera ? pr.camera_vote_weight : 1.0;
+    if (lm.sightings >= pr.confirm_sightings) lm.confirmed = true;
+    s.misses = 0;
   }
+}
 
+void FastSlam::expect_and_remove(Particle& p, const std::vector<int>& taken) {
   // expectations and removal of the landmarks that were there before this frame
   // (in view: |b| < view_range and |bearing| < view_half_fov <=> b_x > |b| cos(view_half_fov))
-  cy = std::cos(p.pose.yaw);
-  sy = std::sin(p.pose.yaw);
+  const FastSlamParams& pr = params_;
+  const double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
   const double cos_fov = std::cos(pr.view_half_fov);
-  for (int i : near) {
+  for (int i : near_) {
     const Slot& cs = p.slot(i);
     const bool seen = std::find(taken.begin(), taken.end(), i) != taken.end();
     const Vec2 d = cs.lm.mean - p.pose.position();
@@ -354,9 +355,14 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
     const int misses = s.lm.confirmed ? pr.remove_misses : pr.remove_tentative_misses;
     if (rare || s.misses >= misses) s.alive = false;
   }
+}
 
+void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik) {
   // observations without a landmark start tentative ones
-  for (std::size_t k = 0; k < m; ++k) {
+  const FastSlamParams& pr = params_;
+  const double log_p0 = std::log(pr.new_landmark_likelihood);
+  const double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
+  for (std::size_t k = 0; k < f.z.size(); ++k) {
     if (match[k] >= 0) continue;
     const Observation& o = *f.obs[k];
     log_lik += log_p0;
@@ -372,6 +378,22 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
     s.lm.confirmed = s.lm.sightings >= pr.confirm_sightings;
     p.add(s);
   }
+}
+
+void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
+  const bool v2 = params_.version == 2;
+  // FastSLAM 1.0: the pose from the motion model before anything else
+  if (!v2) {
+    p.pose = sample_pose(p.pose, p.P);
+    p.P.setZero();
+  }
+  gather_near(p);
+  std::vector<int> taken;  // landmarks matched this frame
+  const std::vector<int> match = associate(p, f, taken);
+  if (v2) propose_and_sample(p, f, match, log_lik);
+  update_landmarks(p, f, match, log_lik);
+  expect_and_remove(p, taken);
+  add_new_landmarks(p, f, match, log_lik);
 }
 
 void FastSlam::resample() {

@@ -264,6 +264,16 @@ class FastSlam {
   struct Frame;  // an update's prepared observations
 
   void update_particle(Particle& p, const Frame& f, double& log_lik);
+  // its parts, in order: the landmarks near the particle (into near_), the
+  // association (observation -> landmark or -1; the landmarks taken), the
+  // 2.0 proposal and the pose drawn from it, the associated landmarks'
+  // EKFs, the expectations and removals, the new tentative landmarks
+  void gather_near(const Particle& p);
+  std::vector<int> associate(const Particle& p, const Frame& f, std::vector<int>& taken) const;
+  void propose_and_sample(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
+  void update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
+  void expect_and_remove(Particle& p, const std::vector<int>& taken);
+  void add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
   Pose2 sample_pose(const Pose2& mean, const Eigen::Matrix3d& cov);
   std::vector<Landmark> landmarks(bool confirmed_only) const;
 
