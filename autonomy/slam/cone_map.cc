@@ -5,19 +5,7 @@
 
 namespace paddock::slam {
 
-ConeColor MappedCone::color() const {
-  // the most voted colour; unknown only when nothing coloured was ever seen
-  int best = -1;
-  int best_votes = 0;
-  for (int c = 0; c < 5; ++c) {
-    if (static_cast<ConeColor>(c) == ConeColor::Unknown) continue;
-    if (votes[static_cast<std::size_t>(c)] > best_votes) {
-      best = c;
-      best_votes = votes[static_cast<std::size_t>(c)];
-    }
-  }
-  return best < 0 ? ConeColor::Unknown : static_cast<ConeColor>(best);
-}
+ConeColor MappedCone::color() const { return most_voted(votes); }
 
 ConeMap::ConeMap(const ConeMapParams& params) : params_(params) {}
 

@@ -32,6 +32,22 @@ struct ConeMapParams {
   }
 };
 
+// the most voted colour of per-ConeColor votes (in enum order); unknown
+// only when no coloured vote was ever cast
+template <class T>
+ConeColor most_voted(const std::array<T, 5>& votes) {
+  int best = -1;
+  T best_votes = 0;
+  for (int c = 0; c < 5; ++c) {
+    if (static_cast<ConeColor>(c) == ConeColor::Unknown) continue;
+    if (votes[static_cast<std::size_t>(c)] > best_votes) {
+      best = c;
+      best_votes = votes[static_cast<std::size_t>(c)];
+    }
+  }
+  return best < 0 ? ConeColor::Unknown : static_cast<ConeColor>(best);
+}
+
 struct MappedCone {
   Vec2 position;                     // mean of the associated observations (m, map frame)
   int observations = 0;

@@ -69,18 +69,7 @@ Pose2 compose(const Pose2& s, const Pose2& d) {
 
 }  // namespace
 
-ConeColor Landmark::color() const {
-  int best = -1;
-  double best_votes = 0.0;
-  for (int c = 0; c < 5; ++c) {
-    if (static_cast<ConeColor>(c) == ConeColor::Unknown) continue;
-    if (votes[static_cast<std::size_t>(c)] > best_votes) {
-      best = c;
-      best_votes = votes[static_cast<std::size_t>(c)];
-    }
-  }
-  return best < 0 ? ConeColor::Unknown : static_cast<ConeColor>(best);
-}
+ConeColor Landmark::color() const { return most_voted(votes); }
 
 FastSlam::Slot& FastSlam::Particle::mutable_slot(int i) {
   std::shared_ptr<Block>& b = blocks[i / kLandmarkBlock];

@@ -93,6 +93,7 @@
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
 #include "autonomy/common/params.h"
+#include "autonomy/slam/cone_map.h"
 
 namespace paddock::slam {
 
