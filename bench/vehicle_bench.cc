@@ -4,10 +4,9 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
-#include <fstream>
-#include <stdexcept>
 #include <string>
 
+#include "sim/runner/scenario.h"
 #include "sim/vehicle/vehicle.h"
 
 namespace {
@@ -15,34 +14,9 @@ namespace {
 using namespace paddock;
 using namespace paddock::vehicle;
 
-// the default car from scenarios/vehicles/default.ini (a bare key = value reader: the
-// scenario parser proper belongs to sim/runner)
+// the default car, read by the scenario loader
 VehicleParams bench_params() {
-  const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/scenarios/vehicles/default.ini";
-  std::ifstream f(path);
-  if (!f) throw std::runtime_error("cannot open " + path);
-  VehicleParams p;
-  // sets the field named key (the fields as VehicleParams::visit lists them)
-  struct Setter {
-    std::string key, value;
-    void operator()(const char* name, double& field, const params::Spec&) {
-      if (key == name) field = std::stod(value);
-    }
-  };
-  std::string line;
-  while (std::getline(f, line)) {
-    line = line.substr(0, line.find(';'));
-    const auto eq = line.find('=');
-    if (eq == std::string::npos) continue;
-    std::string key = line.substr(0, eq);
-    key.erase(0, key.find_first_not_of(" \t"));
-    key.erase(key.find_last_not_of(" \t") + 1);
-    Setter set{key, line.substr(eq + 1)};
-    p.visit(set);
-  }
-  const std::string problem = params::validate(p);
-  if (!problem.empty()) throw std::runtime_error(path + ": " + problem);
-  return p;
+  return runner::load_vehicle_file(std::string(PADDOCK_SOURCE_DIR) + "/scenarios/vehicles/default.ini");
 }
 
 void BM_VehicleStepCornering(benchmark::State& st) {

@@ -280,6 +280,22 @@ std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream) 
   return scenario_seed;
 }
 
+estimation::CarGeometry car_geometry(const vehicle::VehicleParams& v, const sensors::ImuParams& imu) {
+  estimation::CarGeometry g;
+  g.lf = v.lf;
+  g.lr = v.lr;
+  g.track_front = v.track_front;
+  g.track_rear = v.track_rear;
+  g.wheel_radius = v.wheel_radius;
+  g.imu_x = imu.mount_x;
+  g.imu_y = imu.mount_y;
+  // the slip the wheels show per m/s^2: 1 / (g B_x C D_x), the tyre's slip stiffness per load
+  g.slip_per_accel = 1.0 / (kGravity * v.tyre_bx * v.tyre_c * v.tyre_dx);
+  g.drag_per_mass = v.c_drag / v.mass;
+  g.cornering_stiffness = v.tyre_b * v.tyre_c * v.tyre_d;
+  return g;
+}
+
 stack::StackParams stack_params(const Scenario& s) {
   stack::StackParams p;
   p.autonomy = s.autonomy;
@@ -311,20 +327,7 @@ stack::StackParams stack_params(const Scenario& s) {
   p.perception.camera = sensors::camera_calibration(s.camera);
   p.planning = s.planning;
   p.slam = s.slam;
-  // the estimator's knowledge of the car: its geometry, where the IMU sits,
-  // and the tyres' slip stiffnesses (the slip the wheels show per
-  // acceleration, the rear axle's cornering stiffness)
-  estimation::CarGeometry& g = p.slam.geometry;
-  g.lf = v.lf;
-  g.lr = v.lr;
-  g.track_front = v.track_front;
-  g.track_rear = v.track_rear;
-  g.wheel_radius = v.wheel_radius;
-  g.imu_x = s.imu.mount_x;
-  g.imu_y = s.imu.mount_y;
-  g.slip_per_accel = 1.0 / (kGravity * v.tyre_bx * v.tyre_c * v.tyre_dx);
-  g.drag_per_mass = v.c_drag / v.mass;
-  g.cornering_stiffness = v.tyre_b * v.tyre_c * v.tyre_d;
+  p.slam.geometry = car_geometry(v, s.imu);
   p.planning.reference.profile.mass = v.mass;
   p.planning.reference.profile.drag_coefficient = v.c_drag;
   // the skidpad's reference uses the same planned limits

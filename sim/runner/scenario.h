@@ -177,6 +177,10 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
 // (1 kHz) cannot integrate stably
 vehicle::VehicleParams load_vehicle_file(const std::string& path);
 
+// what the stack's state estimator knows of the car and its IMU: the
+// geometry, the IMU's mount, and the tyres' slip and cornering stiffnesses
+estimation::CarGeometry car_geometry(const vehicle::VehicleParams& v, const sensors::ImuParams& imu);
+
 
 // the resolved scenario as INI text: every key, defaults included, in SI units,
 // loadable again to the same Scenario

@@ -21,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "sim/runner/scenario.h"
 #include "sim/sensors/imu.h"
 #include "sim/sensors/odometry_sensors.h"
 #include "sim/vehicle/vehicle.h"
@@ -31,41 +32,9 @@ namespace {
 constexpr double kDt = 1e-3;          // s, the simulator's physics step
 constexpr TimeNs kStepNs = 1'000'000;  // ns
 
-// a minimal reader of scenarios/vehicles/default.ini (as tests/vehicle does: the
-// real parser lives in sim/runner): `key = value ; comment` lines of one [vehicle] section
+// a car file, read by the scenario loader
 vehicle::VehicleParams load_car(const std::string& car) {
-  const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/scenarios/vehicles/" + car + ".ini";
-  std::ifstream f(path);
-  EXPECT_TRUE(f.good()) << "cannot open " << path;
-  vehicle::VehicleParams p;
-  struct Lister {
-    std::vector<std::pair<std::string, double*>> fields;
-    void operator()(const char* key, double& field, const params::Spec&) { fields.emplace_back(key, &field); }
-  } lister;
-  p.visit(lister);
-  std::set<std::string> seen;
-  std::string line;
-  while (std::getline(f, line)) {
-    const auto semi = line.find(';');
-    if (semi != std::string::npos) line.resize(semi);
-    const auto first = line.find_first_not_of(" \t\r");
-    if (first == std::string::npos || line[first] == '[') continue;
-    const auto eq = line.find('=');
-    std::string key = line.substr(first, eq - first);
-    key.erase(key.find_last_not_of(" \t") + 1);
-    for (const auto& [name, field] : lister.fields)
-      if (key == name) {
-        *field = std::stod(line.substr(eq + 1));
-        seen.insert(key);
-      }
-  }
-  EXPECT_EQ(seen.size(), lister.fields.size()) << path << " must set every field";
-  EXPECT_EQ(params::validate(p), "");
-  return p;
-}
-
-CarGeometry geometry_of(const vehicle::VehicleParams& car) {
-  return CarGeometry{car.lf, car.lr, car.track_front, car.track_rear, car.wheel_radius};
+  return runner::load_vehicle_file(std::string(PADDOCK_SOURCE_DIR) + "/scenarios/vehicles/" + car + ".ini");
 }
 
 // one sample of the run: the truth and the estimate at a wheel-speed message
@@ -93,7 +62,7 @@ DriveLog drive(const vehicle::VehicleParams& car, vehicle::VehicleState s, const
   sensors::Imu imu(ip, seed * 3 + 1);
   sensors::WheelSpeedSensor wheels({}, seed * 3 + 2);
   sensors::SteeringSensor steering({}, seed * 3 + 3);
-  VelocityEkf ekf(ep, geometry_of(car));
+  VelocityEkf ekf(ep, runner::car_geometry(car, ip));
   ekf.reset(vehicle::base_pose(car, s), 0);
   DriveLog run;
   const int steps = static_cast<int>(std::lround(duration / kDt));
