@@ -61,6 +61,17 @@ struct Pose2 {
   Vec2 inverse_transform(Vec2 p) const { return rotate(p - position(), -yaw); }
 };
 
+// s (+) d: the pose d, given in s's frame, in s's parent frame
+inline Pose2 compose(const Pose2& s, const Pose2& d) {
+  const Vec2 p = s.transform({d.x, d.y});
+  return {p.x, p.y, wrap_angle(s.yaw + d.yaw)};
+}
+// a^-1 (+) b: the pose b in a's frame (the motion from a to b)
+inline Pose2 between(const Pose2& a, const Pose2& b) {
+  const Vec2 d = a.inverse_transform(b.position());
+  return {d.x, d.y, wrap_angle(b.yaw - a.yaw)};
+}
+
 // no NaN and no infinity in a value: the first check of every module's input
 inline bool finite(double v) { return std::isfinite(v); }
 inline bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }

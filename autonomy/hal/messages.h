@@ -40,6 +40,9 @@ struct ResSignal {
 struct DetectedCone {
   Vec2 position;                        // base frame (m)
   ConeColor color = ConeColor::Unknown;
+  // the colour came from a camera (a network's class, or an object-level
+  // sensor's); else from the LiDAR's intensity profile, a weaker vote
+  bool colour_from_camera = false;
 };
 
 // one frame of cone detections (the `perception = ground_truth` source: an

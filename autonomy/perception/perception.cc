@@ -102,7 +102,7 @@ const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
       ++stats_.dropped_by_fusion;
       continue;
     }
-    out.cones.push_back({{cands[i].centre.x(), cands[i].centre.y()}, f.color});
+    out.cones.push_back({{cands[i].centre.x(), cands[i].centre.y()}, f.color, f.source == FusionSource::Camera});
   }
   return out;
 }

@@ -3,9 +3,10 @@
 // detection is associated with the nearest mapped cone within a gate, whose
 // position is the running mean of its observations and whose colour is the
 // majority of the coloured votes. With `slam = ground_truth` the poses are the
-// true ones; a SLAM back end later feeds its own estimates in.
+// true ones; with the SLAM modes the back end's map replaces it (assign).
 #include <array>
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 #include "autonomy/common/cone.h"
@@ -51,7 +52,7 @@ ConeColor most_voted(const std::array<T, 5>& votes) {
 struct MappedCone {
   Vec2 position;                     // mean of the associated observations (m, map frame)
   int observations = 0;
-  std::array<int, 5> votes{};        // per ConeColor, in enum order
+  std::array<double, 5> votes{};     // per ConeColor, in enum order (weights: a vote is 1 here)
   ConeColor color() const;           // the most voted colour, ignoring unknown unless it is all there is
 };
 
@@ -67,6 +68,9 @@ class ConeMap {
   const std::vector<MappedCone>& all() const { return cones_; }
   std::size_t size() const { return cones_.size(); }
   void clear() { cones_.clear(); }
+  // the map as a SLAM back end estimated it (its landmarks, their sightings
+  // and votes), replacing what was there
+  void assign(std::vector<MappedCone> cones) { cones_ = std::move(cones); }
 
  private:
   ConeMapParams params_;

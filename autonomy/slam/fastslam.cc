@@ -62,11 +62,6 @@ double mahalanobis2(const Vector2d& nu, const Matrix2d& S) {
   return (S(1, 1) * nu(0) * nu(0) - (S(0, 1) + S(1, 0)) * nu(0) * nu(1) + S(0, 0) * nu(1) * nu(1)) / det;
 }
 
-Pose2 compose(const Pose2& s, const Pose2& d) {
-  const Vec2 p = s.transform({d.x, d.y});
-  return {p.x, p.y, wrap(s.yaw + d.yaw)};
-}
-
 }  // namespace
 
 ConeColor Landmark::color() const { return most_voted(votes); }
@@ -226,7 +221,7 @@ std::vector<int> FastSlam::associate(const Particle& p, const Frame& f, std::vec
   // maximum likelihood per observation, within the gate and above the
   // new-landmark likelihood, one observation per landmark (mutual exclusion)
   const FastSlamParams& pr = params_;
-  const bool v2 = pr.version == 2;
+  const bool v2 = pr.fastslam_version == 2;
   const std::size_t m = f.z.size();
   const double log_p0 = std::log(pr.new_landmark_likelihood);
   // the pose's rotation (at s^ for 2.0, at the sampled pose for 1.0)
@@ -309,7 +304,7 @@ void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<i
     const Predicted h = predict_measurement(p.pose, lm.mean);
     const Matrix2d S = h.Hm * lm.cov * h.Hm.transpose() + f.R[k];
     const Vector2d nu = innovation(f.z[k], h.z);
-    if (pr.version != 2) log_lik += log_gauss(nu, S, nullptr);
+    if (pr.fastslam_version != 2) log_lik += log_gauss(nu, S, nullptr);
     const Matrix2d K = lm.cov * h.Hm.transpose() * S.inverse();
     const Vector2d dm = K * nu;
     lm.mean += Vec2{dm(0), dm(1)};
@@ -370,7 +365,7 @@ void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<
 }
 
 void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
-  const bool v2 = params_.version == 2;
+  const bool v2 = params_.fastslam_version == 2;
   // FastSLAM 1.0: the pose from the motion model before anything else
   if (!v2) {
     p.pose = sample_pose(p.pose, p.P);

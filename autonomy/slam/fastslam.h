@@ -100,7 +100,7 @@ namespace paddock::slam {
 struct FastSlamParams {
   // 2: the proposal folds the measurements in, which pays where the motion
   // noise exceeds the measurement noise (the paper's reason to adopt it)
-  int version = 2;
+  int fastslam_version = 2;
   // 200: bench/fastslam_bench.cc, one update with ~20 observations on a map
   // of 150 landmarks on one core: 200 particles 1.7 ms mean, 2.1-2.9 ms
   // p99; 300: 2.5 ms, 3.0-3.8 ms p99. 200 keeps a 1.6x margin to a 5 ms
@@ -169,7 +169,7 @@ struct FastSlamParams {
 
   template <class V>
   void visit(V& v) {
-    v(PADDOCK_PARAM(version), {"", params::in(1, 2), "1: FastSLAM 1.0 (motion-model proposal), 2: FastSLAM 2.0 (proposal folds the measurements in)"});
+    v(PADDOCK_PARAM(fastslam_version), {"", params::in(1, 2), "1: FastSLAM 1.0 (motion-model proposal), 2: FastSLAM 2.0 (proposal folds the measurements in)"});
     v(PADDOCK_PARAM(particles), {"", params::in(1, 100000), "number of particles"});
     v(PADDOCK_PARAM(range_std), {"m", params::above_up_to(0.0, 10.0), "range noise std of an observation (constant part)"});
     v(PADDOCK_PARAM(range_std_per_m), {"", params::in(0.0, 1.0), "range noise std per m of range"});

@@ -45,10 +45,8 @@ Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<percep
     pp.use_camera = params_.autonomy.perception == PerceptionMode::LidarCamera;
     perception_ = std::make_unique<perception::Perception>(pp, std::move(detector));
   }
-  if (params_.autonomy.slam == SlamMode::Odometry) {
-    ekf_.emplace(params_.slam.velocity, params_.slam.geometry);
-    ekf_->reset(spec_.start_pose, 0);
-  }
+  if (params_.autonomy.slam != SlamMode::GroundTruth)
+    localisation_.emplace(params_.slam, params_.autonomy.slam, spec_.start_pose);
   if (params_.autonomy.planner != PlannerMode::Oracle) return;
   // planner = oracle: the whole reference is planned once, before the start;
   // an open path starts free (the car launches at full drive) and ends at rest
@@ -69,28 +67,27 @@ void Stack::take_estimate(const hal::StateEstimate& est) {
 }
 
 void Stack::on_message(hal::SensorMessage&& m) {
-  // the odometry sensors feed the estimator (slam = odometry) and the LiDAR's
-  // motion correction (perception = lidar | lidar_camera)
+  // the odometry sensors feed the localisation (slam != ground_truth) and the
+  // LiDAR's motion correction (perception = lidar | lidar_camera)
   if (const auto* imu = std::get_if<hal::Imu>(&m)) {
-    if (ekf_ && ekf_->on_imu(*imu) == estimation::EkfStatus::Ok) {
-      const estimation::VelocityEstimate e = ekf_->estimate();
-      take_estimate(hal::StateEstimate{e.stamp, e.pose, e.vx, e.vy, e.yaw_rate});
+    if (localisation_) {
+      if (const std::optional<hal::StateEstimate> e = localisation_->on_imu(*imu)) take_estimate(*e);
     }
     if (perception_) perception_->add(*imu);
     return;
   }
   if (const auto* wheels = std::get_if<hal::WheelSpeeds>(&m)) {
-    if (ekf_) ekf_->on_wheel_speeds(*wheels);
+    if (localisation_) localisation_->on_wheel_speeds(*wheels);
     if (perception_) perception_->add(*wheels);
     return;
   }
   if (const auto* steering = std::get_if<hal::SteeringAngle>(&m)) {
-    if (ekf_) ekf_->on_steering(*steering);
+    if (localisation_) localisation_->on_steering(*steering);
     return;
   }
   if (const auto* est = std::get_if<hal::StateEstimate>(&m)) {
     // slam = ground_truth: handed in; otherwise the stack keeps its own
-    if (!ekf_) take_estimate(*est);
+    if (!localisation_) take_estimate(*est);
   } else if (const auto* det = std::get_if<hal::ConeDetections>(&m)) {
     on_detections(*det);
   } else if (const auto* res = std::get_if<hal::ResSignal>(&m)) {
@@ -123,6 +120,11 @@ std::optional<Pose2> Stack::pose_at(TimeNs t) const {
 void Stack::on_detections(const hal::ConeDetections& d) {
   last_detections_ = d;
   ++detection_frames_;
+  // slam = fastslam: the map is SLAM's
+  if (localisation_ && localisation_->owns_map()) {
+    localisation_->on_detections(d);
+    return;
+  }
   // slam = ground_truth: the detections go into the map at the pose the car
   // had when they were measured; a frame newer than the newest state estimate
   // waits for it (a scan closes just before the state of that instant arrives)
@@ -322,6 +324,10 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
     waiting_.pop_front();
   }
   while (waiting_.size() > 4) waiting_.pop_front();  // no state estimates: the old frames are of no use
+  if (localisation_ && localisation_->take_map_news()) {
+    cone_map_.assign(localisation_->map());
+    map_news_ = true;
+  }
   const double dt = last_tick_ ? to_seconds(now - *last_tick_) : 0.0;
   last_tick_ = now;
 

@@ -17,9 +17,9 @@
 #include "autonomy/perception/perception.h"
 #include "autonomy/planning/path_planner.h"
 #include "autonomy/planning/skidpad.h"
-#include "autonomy/estimation/velocity_ekf.h"
 #include "autonomy/slam/cone_map.h"
 #include "autonomy/stack/gates.h"
+#include "autonomy/stack/localisation.h"
 
 namespace paddock::stack {
 
@@ -28,14 +28,13 @@ namespace paddock::stack {
 // cone detections; lidar = the LiDAR pipeline on raw scans (intensity colour);
 // lidar_camera = the LiDAR pipeline fused with the camera detector's boxes
 enum class PerceptionMode { GroundTruth, Lidar, LidarCamera };
-enum class SlamMode { GroundTruth, Odometry };
 enum class PlannerMode { Oracle, Delaunay };
 
 struct AutonomyModes {
   static constexpr params::Choice<PerceptionMode> kPerceptionNames[] = {
       {"ground_truth", PerceptionMode::GroundTruth}, {"lidar", PerceptionMode::Lidar}, {"lidar_camera", PerceptionMode::LidarCamera}};
-  static constexpr params::Choice<SlamMode> kSlamNames[] = {{"ground_truth", SlamMode::GroundTruth},
-                                                            {"odometry", SlamMode::Odometry}};
+  static constexpr params::Choice<SlamMode> kSlamNames[] = {
+      {"ground_truth", SlamMode::GroundTruth}, {"odometry", SlamMode::Odometry}, {"fastslam", SlamMode::FastSlam}};
   static constexpr params::Choice<PlannerMode> kPlannerNames[] = {{"delaunay", PlannerMode::Delaunay},
                                                                   {"oracle", PlannerMode::Oracle}};
   PerceptionMode perception = PerceptionMode::GroundTruth;
@@ -100,18 +99,6 @@ struct MissionParams {
     v(PADDOCK_PARAM(skidpad_crossing_ahead), {"m", params::at_least(0.0),
                                               "skidpad: the car's base starts this far before the timekeeping line at the crossing"});
     v(PADDOCK_PARAM(skidpad_min_cones), {"", params::at_least(0), "skidpad: mapped cones needed before the layout is aligned"});
-  }
-};
-
-// [slam]: how the stack estimates its own state (slam != ground_truth)
-struct SlamParams {
-  estimation::VelocityEkfParams velocity;
-  // not visited: the runner fills it from the vehicle ([vehicle])
-  estimation::CarGeometry geometry;
-
-  template <class V>
-  void visit(V& v) {
-    v.section(PADDOCK_PARAM(velocity), "the velocity and odometry EKF: IMU, wheel speeds, steering angle (slam = odometry)");
   }
 };
 
@@ -197,6 +184,8 @@ class Stack {
   const Telemetry& telemetry() const { return telemetry_; }
   const Trajectory& trajectory() const { return trajectory_; }
   const slam::ConeMap& cone_map() const { return cone_map_; }
+  // slam != ground_truth: the stack's own localisation, else null
+  const Localisation* localisation() const { return localisation_ ? &*localisation_ : nullptr; }
   // the state estimate the stack drives on (the newest), if any
   const std::optional<hal::StateEstimate>& estimate() const { return state_; }
   // the last planning cycle's result (planner = delaunay), for plots
@@ -242,8 +231,8 @@ class Stack {
   Telemetry telemetry_;
   std::unique_ptr<perception::Perception> perception_;
 
-  // slam = odometry: the estimator fed by the IMU, the wheel speeds and the steering angle
-  std::optional<estimation::VelocityEkf> ekf_;
+  // slam != ground_truth: the stack's own estimate, from the HAL's sensors
+  std::optional<Localisation> localisation_;
   std::optional<hal::StateEstimate> state_;
   std::deque<hal::StateEstimate> history_;  // the last second of state estimates, oldest first
   slam::ConeMap cone_map_;

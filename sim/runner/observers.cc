@@ -110,11 +110,48 @@ void SlamScorer::observe(const SimModel&, SimState& s) {
   heading2_ += h * h;
   max_ = std::max(max_, d);
   ++n_;
+  const stack::Localisation* loc = s.stack.localisation();
+  series_.push_back({to_seconds(e.stamp), d, h, loc ? std::sqrt(std::max(0.0, loc->position_variance())) : 0.0});
+  if (path_.empty() || distance(path_.back(), truth.position()) >= 1.0) path_.push_back(truth.position());
 }
 
-SlamMetrics SlamScorer::metrics() const {
+namespace {
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size())));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+}  // namespace
+
+SlamMetrics SlamScorer::metrics(const SimModel& model, const SimState& state, const std::vector<events::Lap>& laps) const {
   SlamMetrics m;
   m.samples = n_;
+  m.series = series_;
+  m.map = map_metrics(state.stack.cone_map().cones(), model.cones, path_);
+  for (const events::Lap& lap : laps) {
+    SlamLap l;
+    double sum2 = 0.0;
+    long n = 0;
+    for (const SlamSample& x : series_) {
+      if (x.t < lap.start || x.t >= lap.start + lap.time) continue;
+      sum2 += x.error * x.error;
+      l.ate_max = std::max(l.ate_max, x.error);
+      ++n;
+    }
+    l.ate_rms = n > 0 ? std::sqrt(sum2 / static_cast<double>(n)) : 0.0;
+    m.laps.push_back(l);
+  }
+  if (const stack::Localisation* loc = state.stack.localisation()) {
+    const stack::LocalisationStats& st = loc->stats();
+    m.frames = st.frames;
+    m.fallbacks = st.empty_frames + st.dropped_frames;
+    m.loop_closures = st.loop_closures;
+    double sum = 0.0;
+    for (double x : st.update_ms) sum += x;
+    m.update_ms_mean = st.update_ms.empty() ? 0.0 : sum / static_cast<double>(st.update_ms.size());
+    m.update_ms_p99 = percentile(st.update_ms, 0.99);
+  }
   if (n_ == 0) return m;
   m.ate_rms = std::sqrt(sum2_ / static_cast<double>(n_));
   m.heading_rms = std::sqrt(heading2_ / static_cast<double>(n_));

@@ -12,6 +12,7 @@
 #include "autonomy/common/geometry.h"
 #include "sim/events/event.h"
 #include "sim/runner/perception_metrics.h"
+#include "sim/runner/slam_metrics.h"
 
 namespace paddock::runner {
 
@@ -97,21 +98,41 @@ class LogRecorder final : public Observer {
 
 // how far the stack's state estimate lies from the truth: at every log
 // sample, the newest estimate against the true pose at the estimate's own
-// stamp (so a 200 Hz estimate is not blamed for its age)
+// stamp (so a 200 Hz estimate is not blamed for its age); with the stack's
+// own localisation, its final map against the true cones and its cost
+struct SlamSample {
+  double t = 0.0;            // s, the estimate's stamp
+  double error = 0.0;        // m, position error
+  double heading_error = 0.0;  // rad
+  double sigma = 0.0;        // m, sqrt(var x + var y) of the estimate (0: ground truth)
+};
+struct SlamLap {
+  double ate_rms = 0.0, ate_max = 0.0;  // m, over the lap's samples
+};
 struct SlamMetrics {
   double ate_rms = 0.0;      // m, position error (absolute trajectory error)
   double ate_max = 0.0;      // m
   double heading_rms = 0.0;  // rad
   long samples = 0;
+  std::vector<SlamLap> laps;       // per lap of the event
+  MapMetrics map;                  // the stack's final map (cone_map.min_observations)
+  int loop_closures = 0;
+  long frames = 0;                 // frames SLAM processed
+  long fallbacks = 0;              // frames it could not use (no cone, no odometry)
+  double update_ms_mean = 0.0, update_ms_p99 = 0.0;  // wall time of a SLAM update
+  std::vector<SlamSample> series;  // every log sample, for the figures
 };
 class SlamScorer final : public Observer {
  public:
   void observe(const SimModel& model, SimState& state) override;
-  SlamMetrics metrics() const;
+  // the map and the localisation's cost at the end of the run; per lap from the event's laps
+  SlamMetrics metrics(const SimModel& model, const SimState& state, const std::vector<events::Lap>& laps) const;
 
  private:
   double sum2_ = 0.0, heading2_ = 0.0, max_ = 0.0;
   long n_ = 0;
+  std::vector<SlamSample> series_;
+  std::vector<Vec2> path_;  // the true path, a point every metre
 };
 
 // the perception metrics: every frame of cones the stack received, against

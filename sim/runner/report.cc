@@ -80,6 +80,15 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
     << fixed(r.tracking.itae, 1) << " (mean per lap)\n";
   o << "  slam        " << stack::to_string(s.autonomy.slam) << ": ATE rms " << fixed(r.slam.ate_rms, 3) << " m, max "
     << fixed(r.slam.ate_max, 3) << " m, heading rms " << fixed(r.slam.heading_rms, 4) << " rad\n";
+  const MapMetrics& mm = r.slam.map;
+  o << "              map " << mm.map_cones << " cones: rmse " << fixed(mm.rmse, 3) << " m, precision "
+    << fixed(100.0 * mm.precision, 1) << " %, recall " << fixed(100.0 * mm.recall, 1) << " % (of " << mm.true_cones
+    << " within 5 m of the path), colour " << fixed(100.0 * mm.colour_accuracy, 1) << " %\n";
+  if (s.autonomy.slam != stack::SlamMode::GroundTruth) {
+    o << "              " << r.slam.frames << " frames, " << r.slam.fallbacks << " unusable, " << r.slam.loop_closures
+      << " loop closures; update " << fixed(r.slam.update_ms_mean, 2) << " ms mean, " << fixed(r.slam.update_ms_p99, 2)
+      << " ms p99\n";
+  }
   o << "  energy      " << fixed(r.energy / 3600.0, 1) << " Wh drawn from the accumulator over the run (regeneration counted off)\n";
   if (r.perception.frames() > 0) {
     o << "  perception  " << stack::to_string(s.autonomy.perception) << ", " << r.perception.frames()
@@ -112,6 +121,29 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
   }
   return o.str();
 }
+
+namespace {
+nlohmann::json slam_json(const Scenario& s, const SlamMetrics& m) {
+  nlohmann::json laps = nlohmann::json::array();
+  for (const SlamLap& l : m.laps) laps.push_back({{"ate_rms_m", l.ate_rms}, {"ate_max_m", l.ate_max}});
+  return {{"mode", stack::to_string(s.autonomy.slam)},
+          {"ate_rms_m", m.ate_rms},
+          {"ate_max_m", m.ate_max},
+          {"heading_rms_rad", m.heading_rms},
+          {"samples", m.samples},
+          {"map_cones", m.map.map_cones},
+          {"map_rmse_m", m.map.rmse},
+          {"map_precision", m.map.precision},
+          {"map_recall", m.map.recall},
+          {"map_colour_accuracy", m.map.colour_accuracy},
+          {"loop_closures", m.loop_closures},
+          {"frames", m.frames},
+          {"fallbacks", m.fallbacks},
+          {"update_ms_mean", m.update_ms_mean},
+          {"update_ms_p99", m.update_ms_p99},
+          {"laps", laps}};
+}
+}  // namespace
 
 std::string summary_json(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed) {
   using Json = nlohmann::ordered_json;
@@ -170,8 +202,7 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"realtime_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0},
       {"tracking", tracking(r.tracking.rms, r.tracking.max, r.tracking.itae)},
       {"energy", r.energy},
-      {"slam", {{"mode", stack::to_string(s.autonomy.slam)}, {"ate_rms_m", r.slam.ate_rms}, {"ate_max_m", r.slam.ate_max},
-                {"heading_rms_rad", r.slam.heading_rms}, {"samples", r.slam.samples}}},
+      {"slam", slam_json(s, r.slam)},
       {"perception", perception},
       {"stack", {{"fallbacks", r.fallbacks}, {"fault", r.fault}}},
       {"expectations_failed", failed},

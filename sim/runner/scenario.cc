@@ -273,7 +273,7 @@ std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream) 
   };
   static constexpr Stream kStreams[] = {{"cone_sensor", 1, 0},     {"imu", 2, 0},   {"wheel_speeds", 3, 0},
                                         {"steering_sensor", 4, 0}, {"lidar", 5, 0}, {"camera", 5, 0xC0FFEEULL},
-                                        {"detector", 6, 0}};
+                                        {"detector", 6, 0},        {"slam", 7, 0}};
   for (const Stream& s : kStreams)
     if (s.name == stream) return (scenario_seed * 0x9E3779B97F4A7C15ULL + s.offset) ^ s.scramble;
   assert(false && "unknown random stream");
@@ -328,6 +328,7 @@ stack::StackParams stack_params(const Scenario& s) {
   p.planning = s.planning;
   p.slam = s.slam;
   p.slam.geometry = car_geometry(v, s.imu);
+  p.slam.seed = stream_seed(s.scenario.seed, "slam");
   p.planning.reference.profile.mass = v.mass;
   p.planning.reference.profile.drag_coefficient = v.c_drag;
   // the skidpad's reference uses the same planned limits

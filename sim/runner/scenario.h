@@ -193,8 +193,8 @@ world::TrackFile load_track_file(const std::string& path);
 // the seed of one named random stream of a run: every random draw of a run
 // comes from the scenario's seed through this function. The streams:
 // "cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera",
-// "detector"; any other name is a programming error. Their numbering is fixed:
-// changing it changes every result.
+// "detector", "slam" (the stack's particle filter); any other name is a
+// programming error. Their numbering is fixed: changing it changes every result.
 std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream);
 
 // the stack's parameters as compiled from the scenario (the vehicle knowledge

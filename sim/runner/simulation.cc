@@ -213,7 +213,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track) {
   result.sim_time = result.log.empty() ? 0.0 : result.log.back().t;
   tracking_from_log(result.event.laps, result.log, 1.0 / scenario.sim.log_rate, result.lap_tracking, result.tracking);
   result.perception = scorer.metrics();
-  result.slam = slam.metrics();
+  result.slam = slam.metrics(model, state, result.event.laps);
   result.snapshot = std::move(snapshot.snapshot());
   result.wall_time = seconds_since(wall0);
   return result;

@@ -175,6 +175,7 @@ hal::ConeDetections ConeSensor::measure(const std::vector<Cone>& cones, const st
     // big when its colour is lost: a LiDAR measures its height (505 mm against
     // 325 mm), so the timing lines' cones are known even without colour
     det.color = k.color;
+    det.colour_from_camera = true;  // an object-level sensor stands for camera and LiDAR fused
     if (u_unknown < p.unknown_color_probability + p.unknown_color_growth * q) {
       det.color = k.color == ConeColor::BigOrange ? ConeColor::BigOrange : ConeColor::Unknown;
     } else if (u_flip < p.color_flip_probability + p.color_flip_growth * q) {
@@ -200,6 +201,7 @@ hal::ConeDetections ConeSensor::measure(const std::vector<Cone>& cones, const st
       det.color = u_unknown < p.false_positive_unknown_probability
                       ? ConeColor::Unknown
                       : kColors[std::min(3, static_cast<int>(u_color * 4.0))];
+      det.colour_from_camera = true;
       out.cones.push_back(det);
     }
     stats_.false_positives = n;

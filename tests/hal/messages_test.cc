@@ -141,7 +141,8 @@ std::vector<Message> sensor_messages() {
 std::vector<Message> message_parts() {
   return {
       message<DetectedCone>("DetectedCone", {{"position", "object-level perception node: cone position"},
-                                             {"color", "object-level perception node: cone class"}}),
+                                             {"color", "object-level perception node: cone class"},
+                                             {"colour_from_camera", "perception node: which sensor decided the class"}}),
       message<LidarPoint>("LidarPoint", {{"x", "LiDAR packet: range along the beam's azimuth and elevation"},
                                          {"y", "LiDAR packet: range along the beam's azimuth and elevation"},
                                          {"z", "LiDAR packet: range along the beam's azimuth and elevation"},

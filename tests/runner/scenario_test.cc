@@ -188,7 +188,7 @@ TEST_F(ScenarioFile, AnOldKeyNamesItsNewPlace) {
   EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nstanley_k = 2\n")),
               HasSubstr(":5: unknown key 'stanley_k' in [control]; it is now [control.stanley] k"));
   EXPECT_THAT(error_of(write(std::string(kHead) + "[slam]\nmin_observations = 3\n")),
-              HasSubstr(":5: unknown section [slam]; it is now [cone_map] min_observations"));
+              HasSubstr(":5: unknown key 'min_observations' in [slam]; it is now [cone_map] min_observations"));
 }
 
 TEST(Scenario, SectionsAndKeysFollowTheStructPaths) {

@@ -192,8 +192,34 @@ TEST(Simulation, WithSlamOdometryTheTruthNeverCrossesTheHal) {
   EXPECT_LT(r.slam.ate_max, 0.5);
 }
 
+TEST(Simulation, WithFastSlamTheCarLocalisesOnItsOwnMap) {
+  // slam = fastslam on the default perception: the first 6 s, ~60 frames of
+  // LiDAR and camera; the estimate stays within decimetres of the truth
+  // (the odometry alone drifts, see above) and the map the stack plans on
+  // holds real cones where they stand
+  const ScenarioOnTrack& s = default_setup();
+  Scenario fs = s.scenario;
+  fs.autonomy.slam = stack::SlamMode::FastSlam;
+  const RunResult r = run(fs, s.track);
+  ASSERT_FALSE(r.log.empty());
+  EXPECT_GT(std::hypot(r.log.back().x - r.log.front().x, r.log.back().y - r.log.front().y), 20.0);
+  EXPECT_GT(r.slam.frames, 40);
+  EXPECT_EQ(r.slam.fallbacks, 0);
+  EXPECT_LT(r.slam.ate_rms, 0.1);
+  EXPECT_LT(r.slam.ate_max, 0.3);
+  EXPECT_GT(r.slam.map.map_cones, 20);
+  EXPECT_GE(r.slam.map.precision, 0.95);
+  EXPECT_LT(r.slam.map.rmse, 0.1);
+  EXPECT_EQ(r.fallbacks, 0);
+  // deterministic: the particle filter's random stream comes from the seed
+  const RunResult again = run(fs, s.track);
+  ASSERT_EQ(again.log.size(), r.log.size());
+  EXPECT_EQ(again.log.back().x, r.log.back().x);
+  EXPECT_EQ(again.slam.ate_rms, r.slam.ate_rms);
+}
+
 TEST(Simulation, StreamSeedsDifferPerStream) {
-  const char* streams[] = {"cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera", "detector"};
+  const char* streams[] = {"cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera", "detector", "slam"};
   for (const char* a : streams) {
     for (const char* b : streams) {
       if (std::strcmp(a, b) != 0) {

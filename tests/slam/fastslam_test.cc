@@ -47,10 +47,7 @@ Pose2 true_pose(double s) {
 }
 
 // the pose change from a to b in a's frame
-Pose2 delta_of(const Pose2& a, const Pose2& b) {
-  const Vec2 d = a.inverse_transform(b.position());
-  return {d.x, d.y, wrap_angle(b.yaw - a.yaw)};
-}
+Pose2 delta_of(const Pose2& a, const Pose2& b) { return between(a, b); }
 
 struct Noise {
   double range_std = 0.0, range_per_m = 0.0, bearing_std = 0.0;
@@ -67,7 +64,7 @@ Noise realistic() {
 
 FastSlamParams params_for(const Noise& n, int version, int particles) {
   FastSlamParams p;
-  p.version = version;
+  p.fastslam_version = version;
   p.particles = particles;
   // the filter knows the test sensor's noise (a positive floor where it is exact)
   p.range_std = std::max(n.range_std, 0.02);
@@ -170,7 +167,7 @@ TEST(FastSlam, LandmarkEkfStepMatchesTheHandDerivedCase) {
   //   m = (10, 0) + K nu = (10.1, 0.05);  C = (I - K H_m) C0 = diag(0.005, 0.005)
   for (int version : {1, 2}) {
     FastSlamParams p;
-    p.version = version;
+    p.fastslam_version = version;
     p.particles = 1;
     p.range_std = 0.1;
     p.range_std_per_m = 0.0;

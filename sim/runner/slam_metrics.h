@@ -1,0 +1,31 @@
+#pragma once
+// how good the stack's final map is: its cones against the true cones,
+// matched one to one within a radius, nearest pairs first
+//   precision: matched map cones / map cones
+//   recall: matched true cones / true cones within the driven corridor (the
+//     cones the car passed within `corridor` of; the others it may never
+//     have seen)
+//   rmse: of the matched pairs' distances
+//   colour accuracy: matched pairs whose colour is the true one (unknown is wrong)
+#include <vector>
+
+#include "autonomy/common/cone.h"
+#include "autonomy/common/geometry.h"
+
+namespace paddock::runner {
+
+struct MapMetrics {
+  int map_cones = 0;
+  int true_cones = 0;  // within the corridor
+  int matched = 0;
+  double rmse = 0.0;              // m
+  double precision = 0.0;         // 0 with an empty map
+  double recall = 0.0;            // 1 with no true cone in the corridor
+  double colour_accuracy = 0.0;   // 0 with no match
+};
+
+// path: the true positions the car drove through (any spacing below corridor)
+MapMetrics map_metrics(const std::vector<Cone>& map, const std::vector<Cone>& truth, const std::vector<Vec2>& path,
+                       double match_radius = 1.0, double corridor = 5.0);
+
+}  // namespace paddock::runner
