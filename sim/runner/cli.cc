@@ -121,6 +121,11 @@ int cmd_run(const std::vector<std::string>& args) {
   write_file_atomic(out_dir + "/scenario.ini", resolved_ini(scenario));
   write_file_atomic(out_dir + "/log.csv", log_csv(result.log));
   write_file_atomic(out_dir + "/plan.json", plan_json(result));
+  if (scenario.autonomy.slam != stack::SlamMode::GroundTruth) {
+    write_file_atomic(out_dir + "/slam.csv", slam_csv(result.slam.series));
+  } else {
+    std::filesystem::remove(out_dir + "/slam.csv");  // a earlier run's in the same place would be drawn
+  }
   write_file_atomic(out_dir + "/summary.json", js);
   if (result.snapshot) {
     write_file_atomic(out_dir + "/perception.json", perception_json(*result.snapshot));

@@ -111,7 +111,8 @@ void SlamScorer::observe(const SimModel&, SimState& s) {
   max_ = std::max(max_, d);
   ++n_;
   const stack::Localisation* loc = s.stack.localisation();
-  series_.push_back({to_seconds(e.stamp), d, h, loc ? std::sqrt(std::max(0.0, loc->position_variance())) : 0.0});
+  series_.push_back(
+      {to_seconds(e.stamp), e.pose, truth, d, h, loc ? std::sqrt(std::max(0.0, loc->position_variance())) : 0.0});
   if (path_.empty() || distance(path_.back(), truth.position()) >= 1.0) path_.push_back(truth.position());
 }
 

@@ -101,10 +101,11 @@ class LogRecorder final : public Observer {
 // stamp (so a 200 Hz estimate is not blamed for its age); with the stack's
 // own localisation, its final map against the true cones and its cost
 struct SlamSample {
-  double t = 0.0;            // s, the estimate's stamp
-  double error = 0.0;        // m, position error
+  double t = 0.0;              // s, the estimate's stamp
+  Pose2 estimate, truth;       // the base's pose
+  double error = 0.0;          // m, position error
   double heading_error = 0.0;  // rad
-  double sigma = 0.0;        // m, sqrt(var x + var y) of the estimate (0: ground truth)
+  double sigma = 0.0;          // m, sqrt(var x + var y) of the estimate (0: ground truth)
 };
 struct SlamLap {
   double ate_rms = 0.0, ate_max = 0.0;  // m, over the lap's samples

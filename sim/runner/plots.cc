@@ -1,5 +1,6 @@
 #include "sim/runner/plots.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -16,10 +17,6 @@
 
 namespace paddock::runner {
 namespace {
-
-const char* kLogHeader =
-    "t,x,y,yaw,vx,vy,yaw_rate,steer_cmd,steer,throttle,brake,v_ref,lateral_error,heading_error,s,lap,as_state";
-constexpr int kLogColumns = 17;
 
 // the laps of summary.json, as far as the lap chart and the lap markers need them
 struct SummaryLaps {
@@ -169,8 +166,13 @@ void write_png(const std::string& path, const render::Image& image) {
   write_file_atomic(path, std::string(png.begin(), png.end()));
 }
 
-std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& source) {
-  std::vector<LogRow> rows;
+namespace {
+// a CSV of numbers under a fixed header: one row of `columns` numbers per
+// line; throws UserError "source:line: ..." naming what it expected
+std::vector<std::vector<double>> parse_number_csv(const std::string& text, const std::string& source,
+                                                  const std::string& header, const std::string& what) {
+  const int columns = static_cast<int>(std::count(header.begin(), header.end(), ',')) + 1;
+  std::vector<std::vector<double>> rows;
   std::size_t pos = 0;
   int line = 0;
   while (pos < text.size()) {
@@ -180,23 +182,33 @@ std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& so
     ++line;
     if (!s.empty() && s.back() == '\r') s.pop_back();
     if (line == 1) {
-      if (s != kLogHeader) throw UserError(source + ":1: not a paddock log: expected the header '" + std::string(kLogHeader) + "'");
+      if (s != header) throw UserError(source + ":1: not " + what + ": expected the header '" + header + "'");
       continue;
     }
     if (s.empty()) continue;
-    double v[kLogColumns];
+    std::vector<double> v(static_cast<std::size_t>(columns));
     const char* p = s.c_str();
-    for (int c = 0; c < kLogColumns; ++c) {
+    for (int c = 0; c < columns; ++c) {
       char* end = nullptr;
       errno = 0;
-      v[c] = std::strtod(p, &end);
-      const char want = c + 1 < kLogColumns ? ',' : '\0';
+      v[static_cast<std::size_t>(c)] = std::strtod(p, &end);
+      const char want = c + 1 < columns ? ',' : '\0';
       if (end == p || errno == ERANGE || *end != want) {
         throw UserError(source + ":" + std::to_string(line) + ": column " + std::to_string(c + 1) +
-                        " is not a number or the row does not have " + std::to_string(kLogColumns) + " columns");
+                        " is not a number or the row does not have " + std::to_string(columns) + " columns");
       }
       p = end + (want ? 1 : 0);
     }
+    rows.push_back(std::move(v));
+  }
+  if (line == 0) throw UserError(source + ": empty file, expected " + what);
+  return rows;
+}
+}  // namespace
+
+std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& source) {
+  std::vector<LogRow> rows;
+  for (const std::vector<double>& v : parse_number_csv(text, source, kLogHeader, "a paddock log")) {
     LogRow r;
     r.t = v[0];
     r.x = v[1];
@@ -217,9 +229,68 @@ std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& so
     r.as_state = static_cast<int>(v[16]);
     rows.push_back(r);
   }
-  if (line == 0) throw UserError(source + ": empty file, expected a paddock log");
   return rows;
 }
+
+std::vector<SlamSample> parse_slam_csv(const std::string& text, const std::string& source) {
+  std::vector<SlamSample> rows;
+  for (const std::vector<double>& v : parse_number_csv(text, source, kSlamCsvHeader, "a paddock slam.csv")) {
+    SlamSample x;
+    x.t = v[0];
+    x.estimate = {v[1], v[2], v[3]};
+    x.truth = {v[4], v[5], v[6]};
+    x.error = v[7];
+    x.sigma = v[8];
+    rows.push_back(x);
+  }
+  return rows;
+}
+
+namespace {
+// DIR/slam.csv (slam != ground_truth) -> the SLAM map over the true cones
+// with the estimated and the true paths, and the position error over time
+// with its 3-sigma bound
+std::vector<std::string> plot_slam(const std::string& dir, const render::TrackMapData& track_map,
+                                   const render::FigureStyle& map_style, const render::FigureStyle& chart_style) {
+  const std::string path = dir + "/slam.csv";
+  if (!std::filesystem::exists(path)) return {};
+  const std::vector<SlamSample> series = parse_slam_csv(read_file(path), path);
+  render::TrackMapData map = track_map;
+  map.title = track_map.title.substr(0, track_map.title.find(':')) + ": SLAM map and paths";
+  map.layers.clear();
+  map.speed.clear();
+  map.trajectory.clear();
+  render::MapLayer truth{render::MapLayer::Kind::Polyline, "true path", {40, 40, 40, 255}, 1.0, render::Marker::Circle, {}, false};
+  render::MapLayer estimate{render::MapLayer::Kind::Polyline, "estimated path", {214, 39, 40, 255}, 1.0, render::Marker::Circle, {}, false};
+  for (const SlamSample& x : series) {
+    truth.points.push_back(x.truth.position());
+    estimate.points.push_back(x.estimate.position());
+  }
+  map.layers = {truth, estimate};
+
+  // a point every 0.25 s: the chart draws a marker at each
+  render::LineChartData chart;
+  chart.title = map.title.substr(0, map.title.find(':')) + ": position error of the estimate";
+  chart.x_label = "t [s]";
+  chart.y_label = "error [m]";
+  render::LineSeries err{"position error", {}, {}, {31, 119, 180, 255}, render::Marker::Circle};
+  render::LineSeries bound{"3 sigma", {}, {}, {214, 39, 40, 255}, render::Marker::Cross};
+  double next = -1e9;
+  for (const SlamSample& x : series) {
+    if (x.t < next) continue;
+    next = x.t + 0.25;
+    err.x.push_back(x.t);
+    err.y.push_back(x.error);
+    bound.x.push_back(x.t);
+    bound.y.push_back(3.0 * x.sigma);
+  }
+  chart.series = {err, bound};
+  const std::vector<std::string> paths = {dir + "/slam_map.png", dir + "/slam_error.png"};
+  write_png(paths[0], render::draw_track_map(map, map_style).image);
+  write_png(paths[1], render::draw_line_chart(chart, chart_style).image);
+  return paths;
+}
+}  // namespace
 
 std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) {
   // the run's files: its resolved scenario names the track
@@ -285,6 +356,7 @@ std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) 
   write_png(paths[1], render::draw_controller_data(ctl, chart_style).image);
   write_png(paths[2], render::draw_lap_chart(chart, chart_style).image);
   for (const std::string& p : plot_perception(dir, map_style, chart_style)) paths.push_back(p);
+  for (const std::string& p : plot_slam(dir, map, map_style, chart_style)) paths.push_back(p);
   return paths;
 }
 

@@ -20,7 +20,9 @@ struct PlotOptions {
 };
 
 // draws DIR/map.png, DIR/controller.png and DIR/laps.png (each written
-// atomically) and returns their paths; throws UserError naming the file and
+// atomically), the perception views when the run kept a snapshot, and
+// DIR/slam_map.png and DIR/slam_error.png when it wrote slam.csv, and returns
+// their paths; throws UserError naming the file and
 // line of anything it cannot read
 std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& options);
 
@@ -29,5 +31,7 @@ void write_png(const std::string& path, const render::Image& image);
 
 // log.csv as written by log_csv(); throws UserError "source:line: ..."
 std::vector<LogRow> parse_log_csv(const std::string& text, const std::string& source);
+// slam.csv as written by slam_csv() (no heading error); throws UserError "source:line: ..."
+std::vector<SlamSample> parse_slam_csv(const std::string& text, const std::string& source);
 
 }  // namespace paddock::runner

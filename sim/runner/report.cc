@@ -258,8 +258,7 @@ std::string perception_json(const PerceptionSnapshot& s) {
 }
 
 std::string log_csv(const std::vector<LogRow>& log) {
-  std::string out =
-      "t,x,y,yaw,vx,vy,yaw_rate,steer_cmd,steer,throttle,brake,v_ref,lateral_error,heading_error,s,lap,as_state\n";
+  std::string out = std::string(kLogHeader) + "\n";
   out.reserve(out.size() + log.size() * 200);
   for (const LogRow& r : log) {
     for (double v : {r.t, r.x, r.y, r.yaw, r.vx, r.vy, r.yaw_rate, r.steer_cmd, r.steer, r.throttle, r.brake, r.v_ref,
@@ -271,6 +270,19 @@ std::string log_csv(const std::vector<LogRow>& log) {
     out += ',';
     out += std::to_string(r.as_state);
     out += '\n';
+  }
+  return out;
+}
+
+std::string slam_csv(const std::vector<SlamSample>& series) {
+  std::string out = std::string(kSlamCsvHeader) + "\n";
+  out.reserve(out.size() + series.size() * 120);
+  for (const SlamSample& x : series) {
+    const double v[] = {x.t, x.estimate.x, x.estimate.y, x.estimate.yaw, x.truth.x, x.truth.y, x.truth.yaw, x.error, x.sigma};
+    for (std::size_t i = 0; i < std::size(v); ++i) {
+      out += fmt(v[i]);
+      out += i + 1 < std::size(v) ? ',' : '\n';
+    }
   }
   return out;
 }

@@ -29,7 +29,12 @@ std::string plan_json(const RunResult& r);
 std::string perception_json(const PerceptionSnapshot& s);
 
 // the log rows as CSV with a header line
+inline constexpr const char* kLogHeader =
+    "t,x,y,yaw,vx,vy,yaw_rate,steer_cmd,steer,throttle,brake,v_ref,lateral_error,heading_error,s,lap,as_state";
 std::string log_csv(const std::vector<LogRow>& log);
+// slam.csv: the estimate against the truth at every log sample (slam != ground_truth)
+inline constexpr const char* kSlamCsvHeader = "t,x,y,yaw,x_true,y_true,yaw_true,error,sigma";
+std::string slam_csv(const std::vector<SlamSample>& series);
 
 // a double as the shortest text that reads back to the same value
 std::string fmt(double v);

@@ -93,6 +93,33 @@ TEST(Plots, RawSensorRunsWriteThePerceptionSnapshotAndItsFigures) {
   EXPECT_FALSE(fs::exists(lidar_dir + "/camera.png"));
 }
 
+TEST(Plots, SlamRunsWriteTheirSeriesAndTheSlamFigures) {
+  // slam != ground_truth: slam.csv holds the estimate against the truth at
+  // every sample, its errors are the summary's ATE, and two figures draw it
+  const std::string dir = scratch("slam");
+  const auto o = paddock("run " + kRoot + "/scenarios/fsg_2023_trackdrive.ini --set autonomy.slam=fastslam "
+                         "--set autonomy.perception=ground_truth --set event.timeout=12 --plots --out " + dir);
+  ASSERT_EQ(o.code, 0) << o.output;
+  EXPECT_THAT(o.output, HasSubstr(dir + "/slam_map.png"));
+  EXPECT_EQ(png_at(dir + "/slam_map.png").width, 1600);
+  EXPECT_EQ(png_at(dir + "/slam_error.png").height, 1200);
+  const std::vector<SlamSample> series = parse_slam_csv(read_file(dir + "/slam.csv"), dir + "/slam.csv");
+  const auto j = nlohmann::json::parse(read_file(dir + "/summary.json")).at("slam");
+  ASSERT_EQ(static_cast<long>(series.size()), j.at("samples").get<long>());
+  double sum2 = 0.0, worst = 0.0;
+  for (const SlamSample& x : series) {
+    EXPECT_NEAR(x.error, std::hypot(x.estimate.x - x.truth.x, x.estimate.y - x.truth.y), 1e-9);
+    sum2 += x.error * x.error;
+    worst = std::max(worst, x.error);
+  }
+  EXPECT_NEAR(std::sqrt(sum2 / static_cast<double>(series.size())), j.at("ate_rms_m").get<double>(), 1e-9);
+  EXPECT_EQ(worst, j.at("ate_max_m").get<double>());
+  // the same folder run again with the true state: no SLAM series left behind
+  ASSERT_EQ(paddock("run " + kRoot + "/scenarios/fsg_2023_trackdrive.ini --set autonomy.perception=ground_truth "
+                    "--set event.timeout=2 --out " + dir).code, 0);
+  EXPECT_FALSE(fs::exists(dir + "/slam.csv"));
+}
+
 TEST(Plots, PlotRedrawsAFinishedRunWithOtherSizesAndTheSameFiles) {
   const std::string dir = scratch("redraw");
   ASSERT_EQ(paddock("run " + kRoot + "/scenarios/skidpad.ini --plots --out " + dir).code, 0);
@@ -167,6 +194,14 @@ TEST(LogCsv, ParsesWhatTheRunWritesAndRejectsTheRest) {
   EXPECT_THAT(error("a,b\n"), HasSubstr("l.csv:1: not a paddock log"));
   EXPECT_THAT(error(header + "1,2,3\n"), HasSubstr("l.csv:2: column 3"));
   EXPECT_THAT(error(""), HasSubstr("l.csv: empty file"));
+  // slam.csv the same way
+  EXPECT_EQ(parse_slam_csv("t,x,y,yaw,x_true,y_true,yaw_true,error,sigma\n1,2,3,0,2,3.5,0,0.5,0.1\n", "s.csv")[0].error, 0.5);
+  try {
+    parse_slam_csv("t,x,y,yaw,x_true,y_true,yaw_true,error,sigma\n1,2,x,0,2,3.5,0,0.5,0.1\n", "s.csv");
+    ADD_FAILURE() << "no error";
+  } catch (const UserError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("s.csv:2: column 3"));
+  }
 }
 
 }  // namespace
