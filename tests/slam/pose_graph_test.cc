@@ -174,15 +174,7 @@ std::vector<Cone> stadium_cones(int per_side) {
   return w;
 }
 
-Pose2 compose(const Pose2& a, const Pose2& d) {
-  const Vec2 p = a.transform({d.x, d.y});
-  return {p.x, p.y, wrap_angle(a.yaw + d.yaw)};
-}
-
-Pose2 delta_of(const Pose2& a, const Pose2& b) {
-  const Vec2 d = a.inverse_transform(b.position());
-  return {d.x, d.y, wrap_angle(b.yaw - a.yaw)};
-}
+Pose2 delta_of(const Pose2& a, const Pose2& b) { return between(a, b); }
 
 struct Drive {
   std::vector<Pose2> truth;     // per node
