@@ -153,7 +153,7 @@ void FastSlam::update(const std::vector<Observation>& obs) {
   f.obs.reserve(obs.size());
   for (const Observation& o : obs) {
     const double r = norm(o.position);
-    if (!finite(o.position) || !(r >= params_.min_range)) {
+    if (!finite(o.position) || !(r >= params_.min_range) || static_cast<std::int64_t>(f.obs.size()) >= kIdsPerUpdate) {
       ++rejected_;
       continue;
     }
@@ -166,7 +166,8 @@ void FastSlam::update(const std::vector<Observation>& obs) {
   // each particle: sample its pose, associate, update its map; log-likelihoods
   const std::size_t n = particles_.size();
   std::vector<double> ll(n, 0.0);
-  for (std::size_t i = 0; i < n; ++i) update_particle(particles_[i], f, ll[i]);
+  frame_ids_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) update_particle(particles_[i], f, ll[i], frame_ids_[i]);
 
   // reweight (in logs, about the largest, against underflow) and normalise
   const double top = *std::max_element(ll.begin(), ll.end());
@@ -188,6 +189,10 @@ void FastSlam::update(const std::vector<Observation>& obs) {
     if (particles_[i].weight > particles_[static_cast<std::size_t>(best_)].weight) best_ = static_cast<int>(i);
   }
   neff_ = 1.0 / sum2;
+  best_sightings_.clear();
+  const std::vector<std::int64_t>& ids = frame_ids_[static_cast<std::size_t>(best_)];
+  for (std::size_t k = 0; k < ids.size(); ++k) best_sightings_.emplace_back(ids[k], f.obs[k]->position);
+  ++updates_;
   if (neff_ < params_.resample_neff_ratio * static_cast<double>(n)) resample();
 }
 
@@ -341,7 +346,8 @@ void FastSlam::expect_and_remove(Particle& p, const std::vector<int>& taken) {
   }
 }
 
-void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik) {
+void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik,
+                                 std::vector<std::int64_t>& ids) {
   // observations without a landmark start tentative ones
   const FastSlamParams& pr = params_;
   const double log_p0 = std::log(pr.new_landmark_likelihood);
@@ -352,6 +358,8 @@ void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<
     log_lik += log_p0;
     Slot s;
     s.alive = true;
+    s.lm.id = updates_ * kIdsPerUpdate + static_cast<std::int64_t>(k);
+    ids[k] = s.lm.id;
     s.lm.mean = {p.pose.x + cy * o.position.x - sy * o.position.y, p.pose.y + sy * o.position.x + cy * o.position.y};
     const Predicted h = predict_measurement(p.pose, s.lm.mean);
     const Matrix2d Hinv = h.Hm.inverse();
@@ -364,7 +372,7 @@ void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<
   }
 }
 
-void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
+void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik, std::vector<std::int64_t>& ids) {
   const bool v2 = params_.fastslam_version == 2;
   // FastSLAM 1.0: the pose from the motion model before anything else
   if (!v2) {
@@ -377,7 +385,10 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik) {
   if (v2) propose_and_sample(p, f, match, log_lik);
   update_landmarks(p, f, match, log_lik);
   expect_and_remove(p, taken);
-  add_new_landmarks(p, f, match, log_lik);
+  ids.assign(match.size(), -1);
+  for (std::size_t k = 0; k < match.size(); ++k)
+    if (match[k] >= 0) ids[k] = p.slot(match[k]).lm.id;
+  add_new_landmarks(p, f, match, log_lik, ids);
 }
 
 void FastSlam::resample() {
@@ -407,6 +418,30 @@ void FastSlam::resample() {
   particles_ = std::move(next);
   best_ = new_best;
   ++resamples_;
+}
+
+void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int64_t, Vec2>>& landmarks) {
+  if (!finite(pose)) {
+    ++rejected_;
+    return;
+  }
+  Particle best = particles_[static_cast<std::size_t>(best_)];
+  best.pose = pose;
+  best.P.setZero();
+  best.weight = 1.0 / static_cast<double>(particles_.size());
+  // id -> position, then one pass over the particle's slots
+  std::vector<std::pair<std::int64_t, Vec2>> sorted = landmarks;
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (int i = 0; i < best.size; ++i) {
+    const Slot& s = best.slot(i);
+    if (!s.alive) continue;
+    const auto it = std::lower_bound(sorted.begin(), sorted.end(), s.lm.id,
+                                     [](const auto& a, std::int64_t id) { return a.first < id; });
+    if (it == sorted.end() || it->first != s.lm.id || !finite(it->second)) continue;
+    best.mutable_slot(i).lm.mean = it->second;
+  }
+  for (Particle& p : particles_) p = best;
+  best_ = 0;
 }
 
 Pose2 FastSlam::pose() const {

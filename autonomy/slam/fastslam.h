@@ -86,6 +86,7 @@
 #include <cstdint>
 #include <memory>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -116,13 +117,15 @@ struct FastSlamParams {
   double range_std_per_m = 0.01;
   double bearing_std = 0.2 * kPi / 180.0;
 
-  // odometry noise per predict (one frame's motion): the velocity EKF's
-  // wheel odometry drifts ~1 % of the distance; its gyro-integrated yaw by
-  // the gyro bias it leaves (~1e-3 rad/s, sim/sensors/imu.h's turn-on
-  // residual: 1e-4 rad per m at 10 m/s) and a MEMS gyro's scale error (0.5 %
-  // of the angle turned); the gyro's white noise is far below both
+  // odometry noise per predict (one frame's motion), as measured on the
+  // velocity EKF's dead reckoning against the truth (FSG 2023, 1 m
+  // segments): position 0.8 % of the distance along and 0.7 % across; yaw
+  // 2.3e-4 rad rms per segment on straights (the gyro's noise and bias
+  // residual: per time more than per metre, 3e-4 per m covers it down to
+  // ~8 m/s) and 0.2 % of the angle turned (the model keeps 0.5 %, a MEMS
+  // gyro's scale error)
   double motion_std_xy_per_m = 0.01;
-  double motion_std_yaw_per_m = 1e-4;
+  double motion_std_yaw_per_m = 3e-4;
   double motion_std_yaw_per_rad = 0.005;
 
   // data association
@@ -202,6 +205,11 @@ struct Observation {
 };
 
 struct Landmark {
+  // who started it: (the update's number) * kIdsPerUpdate + (the observation's
+  // index in it). Every particle that starts a landmark from the same
+  // observation gives it the same id (all of them do in the first frame), so
+  // ids name the same cone across particles and lineages
+  std::int64_t id = -1;
   Vec2 mean;                               // map frame, m
   Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();  // m^2
   int sightings = 0;                       // frames it was associated in
@@ -214,6 +222,7 @@ struct Landmark {
 class FastSlam {
  public:
   static constexpr int kLandmarkBlock = 16;
+  static constexpr std::int64_t kIdsPerUpdate = 1 << 16;  // observations of one update past this are rejected
 
   // throws std::invalid_argument on invalid params
   FastSlam(const FastSlamParams& p, std::uint64_t seed);
@@ -239,9 +248,19 @@ class FastSlam {
 
   double effective_particles() const { return neff_; }  // N_eff after the last update
   int resamples() const { return resamples_; }
+  std::int64_t updates() const { return updates_; }  // update() calls so far (the next one's number)
   int rejected() const { return rejected_; }  // ignored observations and deltas
   // low-variance resampling now (update() does it when N_eff is low)
   void resample();
+
+  // the highest-weight particle's association of the last update: for each
+  // observation it used (finite, beyond min_range), the id of the landmark
+  // it was associated with or started, and the observation (base frame)
+  const std::vector<std::pair<std::int64_t, Vec2>>& best_sightings() const { return best_sightings_; }
+  // after a back end (the pose graph) re-estimated the highest-weight
+  // particle's pose and some of its landmarks (by id): every particle becomes
+  // that particle, at `pose`, with those landmarks moved, equal weights
+  void reanchor(const Pose2& pose, const std::vector<std::pair<std::int64_t, Vec2>>& landmarks);
 
  private:
   struct Slot {
@@ -264,7 +283,7 @@ class FastSlam {
   };
   struct Frame;  // an update's prepared observations
 
-  void update_particle(Particle& p, const Frame& f, double& log_lik);
+  void update_particle(Particle& p, const Frame& f, double& log_lik, std::vector<std::int64_t>& ids);
   // its parts, in order: the landmarks near the particle (into near_), the
   // association (observation -> landmark or -1; the landmarks taken), the
   // 2.0 proposal and the pose drawn from it, the associated landmarks'
@@ -274,7 +293,8 @@ class FastSlam {
   void propose_and_sample(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
   void update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
   void expect_and_remove(Particle& p, const std::vector<int>& taken);
-  void add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
+  void add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik,
+                         std::vector<std::int64_t>& ids);
   Pose2 sample_pose(const Pose2& mean, const Eigen::Matrix3d& cov);
   std::vector<Landmark> landmarks(bool confirmed_only) const;
 
@@ -285,6 +305,9 @@ class FastSlam {
   double neff_ = 0.0;
   int resamples_ = 0;
   int rejected_ = 0;
+  std::int64_t updates_ = 0;
+  std::vector<std::vector<std::int64_t>> frame_ids_;  // per particle, per observation, this update
+  std::vector<std::pair<std::int64_t, Vec2>> best_sightings_;
   // scratch of update_particle (kept to spare the allocations)
   std::vector<int> near_;
   std::vector<double> near_x_, near_y_;

@@ -71,7 +71,12 @@ MotionResidual::MotionResidual(double v_, double w_, const Eigen::Vector3d& sqrt
     : v(v_), w(w_), ix(sqrt_info(0)), iy(sqrt_info(1)), iyaw(sqrt_info(2)) {}
 
 MotionMeasurement motion_measurement(const Pose2& odom_prev, const Pose2& odom_curr) {
-  return {distance(odom_prev.position(), odom_curr.position()), 0.5 * wrap_angle(odom_curr.yaw - odom_prev.yaw)};
+  const Pose2 d = between(odom_prev, odom_curr);
+  const double v = std::hypot(d.x, d.y);
+  const double w = 0.5 * d.yaw;
+  // the chord's component across the midpoint direction (w)
+  const double off = -std::sin(w) * d.x + std::cos(w) * d.y;
+  return {v, w, off};
 }
 
 Eigen::Matrix2d observation_whitening(double range, double bearing, const PoseGraphParams& p) {
@@ -87,7 +92,9 @@ Eigen::Matrix2d observation_whitening(double range, double bearing, const PoseGr
 }
 
 Eigen::Vector3d motion_whitening(const MotionMeasurement& m, const PoseGraphParams& p) {
-  const double sxy = std::max(p.motion_std_xy_per_m * m.v, p.motion_std_xy_min);
+  // the odometry's own noise, and the part of its motion the midpoint
+  // model cannot express (off_chord), added in quadrature
+  const double sxy = std::max(std::hypot(p.motion_std_xy_per_m * m.v, m.off_chord), p.motion_std_xy_min);
   const double syaw =
       std::max(p.motion_std_yaw_per_m * m.v + p.motion_std_yaw_per_rad * std::abs(2.0 * m.w), p.motion_std_yaw_min);
   return {1.0 / sxy, 1.0 / sxy, 1.0 / syaw};

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace paddock::stack {
@@ -15,13 +16,24 @@ constexpr std::size_t kMaxWaiting = 4;
 }  // namespace
 
 Localisation::Localisation(const SlamParams& p, SlamMode mode, const Pose2& start)
-    : params_(p), mode_(mode), ekf_(p.velocity, p.geometry), last_frame_odom_(start) {
+    : params_(p), mode_(mode), ekf_(p.velocity, p.geometry), last_frame_odom_(start), start_(start) {
   if (mode == SlamMode::GroundTruth) throw std::invalid_argument("localisation: slam = ground_truth needs none");
   ekf_.reset(start, 0);
-  if (mode_ == SlamMode::FastSlam) {
+  if (mode_ == SlamMode::FastSlam || mode_ == SlamMode::FastSlamGraph) {
     fastslam_.emplace(p.fastslam, p.seed);
     fastslam_->reset(start);
   }
+  // the graph's noise models are the front end's: the same sensors
+  slam::PoseGraphParams& g = params_.graph;
+  const slam::FastSlamParams& f = params_.fastslam;
+  g.range_std = f.range_std;
+  g.range_std_per_m = f.range_std_per_m;
+  g.bearing_std = f.bearing_std;
+  g.min_range = f.min_range;
+  g.motion_std_xy_per_m = f.motion_std_xy_per_m;
+  g.motion_std_yaw_per_m = f.motion_std_yaw_per_m;
+  g.motion_std_yaw_per_rad = f.motion_std_yaw_per_rad;
+  if (mode_ == SlamMode::FastSlamGraph) slam::PoseGraph check(g);  // throws on invalid params
 }
 
 std::optional<hal::StateEstimate> Localisation::on_imu(const hal::Imu& m) {
@@ -78,7 +90,9 @@ std::optional<Pose2> Localisation::odometry_at(TimeNs t) const {
 
 void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
   const auto t0 = std::chrono::steady_clock::now();
-  fastslam_->predict(between(last_frame_odom_, odom));
+  const Pose2 delta = between(last_frame_odom_, odom);
+  fastslam_->predict(delta);
+  driven_ += std::hypot(delta.x, delta.y);
   last_frame_odom_ = odom;
   ++stats_.frames;
   if (d.cones.empty()) {
@@ -92,6 +106,11 @@ void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
     for (const hal::DetectedCone& c : d.cones) obs.push_back({c.position, c.color, c.colour_from_camera});
     fastslam_->update(obs);
     map_news_ = true;
+    if (mode_ == SlamMode::FastSlamGraph) {
+      const bool closure = closes_loop();
+      record_node(odom, closure);
+      if (closure) optimise_graph();
+    }
   }
   correction_ = compose(fastslam_->pose(), between(odom, Pose2{}));
   const Eigen::Matrix3d cov = fastslam_->pose_covariance();
@@ -99,6 +118,72 @@ void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
   odom_variance_at_frame_ = odometry_variance();
   const auto t1 = std::chrono::steady_clock::now();
   stats_.update_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+}
+
+void Localisation::record_node(const Pose2& odom, bool closure) {
+  const Pose2 pose = fastslam_->pose();
+  if (driven_ <= params_.loop_closure.start_distance) start_updates_ = fastslam_->updates();
+  // a node when the odometry moved or turned enough since the last one (and
+  // always at a closure: its pose is what the re-anchoring needs)
+  if (!nodes_.empty()) {
+    const Node& last = nodes_.back();
+    const bool far = distance(odom.position(), last.odom.position()) >= params_.graph.node_spacing ||
+                     std::abs(wrap_angle(odom.yaw - last.odom.yaw)) >= params_.graph.node_spacing_yaw;
+    if (!far && !closure) return;
+  }
+  nodes_.push_back({pose, odom});
+  const int node = static_cast<int>(nodes_.size()) - 1;
+  for (const auto& [id, point] : fastslam_->best_sightings()) sightings_.push_back({node, id, point});
+}
+
+bool Localisation::closes_loop() const {
+  const LoopClosureParams& lc = params_.loop_closure;
+  if (driven_ - last_closure_at_ < lc.min_distance) return false;
+  const Pose2 pose = fastslam_->pose();
+  if (distance(pose.position(), start_.position()) > lc.radius) return false;
+  int matches = 0;
+  for (const auto& [id, point] : fastslam_->best_sightings())
+    matches += id >= 0 && id / slam::FastSlam::kIdsPerUpdate < start_updates_ ? 1 : 0;
+  return matches >= lc.min_matches;
+}
+
+void Localisation::optimise_graph() {
+  const auto t0 = std::chrono::steady_clock::now();
+  ++stats_.loop_closures;
+  last_closure_at_ = driven_;
+  closure_nodes_.push_back(static_cast<int>(nodes_.size()) - 1);
+  // the window: from the closure window_laps back (the start until then)
+  const int laps = params_.loop_closure.window_laps;
+  const int first = static_cast<int>(closure_nodes_.size()) > laps
+                        ? closure_nodes_[closure_nodes_.size() - 1 - static_cast<std::size_t>(laps)]
+                        : 0;
+  slam::PoseGraph graph(params_.graph);
+  for (int i = first; i < static_cast<int>(nodes_.size()); ++i) graph.add_pose(nodes_[i].estimate, nodes_[i].odom);
+  // the landmarks the front end still holds (its current estimate as the
+  // initial value); sightings of landmarks it has dropped are left out
+  std::vector<std::pair<std::int64_t, Vec2>> map;
+  for (const slam::Landmark& l : fastslam_->all_landmarks()) map.emplace_back(l.id, l.mean);
+  std::sort(map.begin(), map.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  for (const Sighting& s : sightings_) {
+    if (s.node < first) continue;
+    const auto it = std::lower_bound(map.begin(), map.end(), s.id, [](const auto& a, std::int64_t id) { return a.first < id; });
+    if (it == map.end() || it->first != s.id) continue;
+    graph.add_landmark(s.id, it->second);
+    graph.add_observation(s.node - first, s.id, s.point);
+  }
+  const slam::PoseGraph::Result r = graph.optimise();
+  if (!r.ok) {
+    ++stats_.graph_failures;
+    stats_.last_fault = "pose graph: " + r.reason;
+  } else {
+    for (int i = first; i < static_cast<int>(nodes_.size()); ++i) nodes_[i].estimate = graph.pose(i - first);
+    for (auto& [id, position] : map) {
+      if (const std::optional<Vec2> l = graph.landmark(id)) position = *l;
+    }
+    fastslam_->reanchor(nodes_.back().estimate, map);
+  }
+  stats_.optimise_ms.push_back(
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
 }
 
 double Localisation::odometry_variance() const {

@@ -6,6 +6,24 @@
 //   fastslam: FastSLAM (1.0 or 2.0) on each frame of cone detections, moved
 //     between frames by the EKF's pose change; its highest-weight particle's
 //     pose corrects the dead reckoning and its map is the stack's
+//   fastslam_graph (the paper's): FastSLAM as the front end, and the pose
+//     graph (slam/pose_graph.h) built while driving from its highest-weight
+//     particle: a node every graph.node_spacing with that particle's pose and
+//     the odometry's, and the landmark ids it associated the node's
+//     observations with. At each loop closure the graph is optimised and
+//     the particles re-anchored on its result.
+//
+// Loop closure: the landmarks FastSLAM started in the first
+// loop_closure.start_distance m of driving are the start's. A closure is a
+// frame whose best particle is within loop_closure.radius of the start pose,
+// has driven loop_closure.min_distance since the start or the last closure,
+// and associated at least loop_closure.min_matches of the start's landmarks
+// (it re-observes them: the loop is closed in the front end's association,
+// the graph then spreads the correction over the loop). A closure fires
+// once per passage, so every lap's end is one too. The graph optimised is a
+// window: the nodes since the closure loop_closure.window_laps closures back
+// (all of them until then), its first node held where the last optimisation
+// put it (the start pose, the first time): a bounded cost per lap.
 //
 // The estimate the stack drives on is the odometry's, carried into the map
 // frame by the newest correction C = s (+) o^-1 (s: SLAM's pose of the base
@@ -28,16 +46,45 @@
 #include "autonomy/hal/messages.h"
 #include "autonomy/slam/cone_map.h"
 #include "autonomy/slam/fastslam.h"
+#include "autonomy/slam/pose_graph.h"
 
 namespace paddock::stack {
 
-enum class SlamMode { GroundTruth, Odometry, FastSlam };
+enum class SlamMode { GroundTruth, Odometry, FastSlam, FastSlamGraph };
+
+// [slam.loop_closure]: when the pose graph is optimised (slam = fastslam_graph)
+struct LoopClosureParams {
+  // the start's landmarks: those started in the first metres of driving
+  // (the sensors' reach at the start line, 20 m, less a margin)
+  double start_distance = 15.0;
+  // back at the start: within this radius of the start pose ...
+  double radius = 10.0;
+  // ... after this much driving since the start or the last closure (well
+  // under the shortest lap, well over the start's landmark's reach)
+  double min_distance = 60.0;
+  // ... and this many of the start's landmarks associated in one frame
+  int min_matches = 3;
+  // the optimised window: the nodes of this many laps
+  int window_laps = 2;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(start_distance), {"m", params::in(0.0, 1000.0), "landmarks started within this driving from the start are the start's"});
+    v(PADDOCK_PARAM(radius), {"m", params::above_up_to(0.0, 1000.0), "a closure happens within this distance of the start pose ..."});
+    v(PADDOCK_PARAM(min_distance), {"m", params::in(0.0, 100000.0), "... after this much driving since the start or the last closure ..."});
+    v(PADDOCK_PARAM(min_matches), {"", params::in(1, 1000), "... with this many of the start's landmarks re-observed in one frame"});
+    v(PADDOCK_PARAM(window_laps), {"", params::in(1, 1000), "the pose graph optimises the nodes of this many laps"});
+  }
+};
 
 // [slam]: how the stack estimates its own state (slam != ground_truth)
 struct SlamParams {
   estimation::VelocityEkfParams velocity;
   // FastSLAM's keys sit in [slam] itself (fastslam_version, particles, ...)
   slam::FastSlamParams fastslam;
+  // its noise models are FastSLAM's (filled by the localisation)
+  slam::PoseGraphParams graph;
+  LoopClosureParams loop_closure;
   // not visited: the runner fills them from the vehicle ([vehicle]) and the
   // scenario's seed
   estimation::CarGeometry geometry;
@@ -47,6 +94,8 @@ struct SlamParams {
   void visit(V& v) {
     fastslam.visit(v);
     v.section(PADDOCK_PARAM(velocity), "the velocity and odometry EKF: IMU, wheel speeds, steering angle");
+    v.section(PADDOCK_PARAM(graph), "the pose graph's solver and nodes (slam = fastslam_graph)");
+    v.section(PADDOCK_PARAM(loop_closure), "when the pose graph is optimised (slam = fastslam_graph)");
   }
 };
 
@@ -55,7 +104,9 @@ struct LocalisationStats {
   long frames = 0;          // frames of detections processed by SLAM
   long empty_frames = 0;    // frames without a cone: motion only, no expectation of the map
   long dropped_frames = 0;  // frames with no odometry at their stamp
-  int loop_closures = 0;    // pose-graph optimisations at a closed loop
+  int loop_closures = 0;    // loop closures detected (each optimises the pose graph)
+  int graph_failures = 0;   // optimisations that failed (the front end's estimate kept)
+  std::vector<double> optimise_ms;  // wall time of each optimisation (inside its frame's update_ms)
   std::vector<double> update_ms;  // wall time of each SLAM update (not part of any result)
   std::string last_fault;   // the reason of the last fallback
 };
@@ -91,9 +142,22 @@ class Localisation {
     TimeNs stamp;
     Pose2 pose;  // odometry frame
   };
+  struct Node {
+    Pose2 estimate;  // the front end's, then the last optimisation's
+    Pose2 odom;
+  };
+  struct Sighting {
+    int node;
+    std::int64_t id;
+    Vec2 point;  // base frame
+  };
   std::optional<Pose2> odometry_at(TimeNs t) const;
   double odometry_variance() const;
   void process(const hal::ConeDetections& d, const Pose2& odom);
+  // slam = fastslam_graph: the frame's node and sightings, and a closure's optimisation
+  void record_node(const Pose2& odom, bool closure);
+  bool closes_loop() const;
+  void optimise_graph();
 
   SlamParams params_;
   SlamMode mode_;
@@ -107,6 +171,14 @@ class Localisation {
   double odom_variance_at_frame_ = 0.0;      // the EKF's then
   bool map_news_ = false;
   LocalisationStats stats_;
+  // slam = fastslam_graph
+  Pose2 start_;
+  double driven_ = 0.0;                  // odometry distance over the frames (m)
+  double last_closure_at_ = 0.0;         // driven_ at the last closure
+  std::vector<Node> nodes_;
+  std::vector<Sighting> sightings_;
+  std::int64_t start_updates_ = 0;       // landmarks started in updates before this one are the start's
+  std::vector<int> closure_nodes_;       // the node of each closure
 };
 
 }  // namespace paddock::stack

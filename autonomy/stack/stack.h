@@ -34,7 +34,10 @@ struct AutonomyModes {
   static constexpr params::Choice<PerceptionMode> kPerceptionNames[] = {
       {"ground_truth", PerceptionMode::GroundTruth}, {"lidar", PerceptionMode::Lidar}, {"lidar_camera", PerceptionMode::LidarCamera}};
   static constexpr params::Choice<SlamMode> kSlamNames[] = {
-      {"ground_truth", SlamMode::GroundTruth}, {"odometry", SlamMode::Odometry}, {"fastslam", SlamMode::FastSlam}};
+      {"ground_truth", SlamMode::GroundTruth},
+      {"odometry", SlamMode::Odometry},
+      {"fastslam", SlamMode::FastSlam},
+      {"fastslam_graph", SlamMode::FastSlamGraph}};
   static constexpr params::Choice<PlannerMode> kPlannerNames[] = {{"delaunay", PlannerMode::Delaunay},
                                                                   {"oracle", PlannerMode::Oracle}};
   PerceptionMode perception = PerceptionMode::GroundTruth;

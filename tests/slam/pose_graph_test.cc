@@ -384,7 +384,9 @@ Eigen::VectorXd stacked(const Eigen::VectorXd& x, const Small& s, const PoseGrap
   for (int i = 1; i < 5; ++i) {
     const Pose2 &a = s.odometry[static_cast<std::size_t>(i) - 1], &b = s.odometry[static_cast<std::size_t>(i)];
     const double v = std::hypot(b.x - a.x, b.y - a.y), dth = wrap_angle(b.yaw - a.yaw);
-    const double sxy = std::max(p.motion_std_xy_per_m * v, p.motion_std_xy_min);
+    // the chord's offset across the midpoint direction a.yaw + dth / 2
+    const double off = v * std::sin(std::atan2(b.y - a.y, b.x - a.x) - a.yaw - dth / 2.0);
+    const double sxy = std::max(std::sqrt(std::pow(p.motion_std_xy_per_m * v, 2) + off * off), p.motion_std_xy_min);
     const double syaw = std::max(p.motion_std_yaw_per_m * v + p.motion_std_yaw_per_rad * std::abs(dth), p.motion_std_yaw_min);
     const Eigen::Vector3d P = pose(i - 1), C = pose(i);
     r(k++) = (C(0) - P(0) - v * std::cos(P(2) + dth / 2.0)) / sxy;
