@@ -420,7 +420,8 @@ void FastSlam::resample() {
   ++resamples_;
 }
 
-void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int64_t, Vec2>>& landmarks) {
+void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int64_t, Vec2>>& landmarks,
+                        std::int64_t forget_from) {
   if (!finite(pose)) {
     ++rejected_;
     return;
@@ -435,6 +436,10 @@ void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int6
   for (int i = 0; i < best.size; ++i) {
     const Slot& s = best.slot(i);
     if (!s.alive) continue;
+    if (s.lm.id / kIdsPerUpdate >= forget_from) {
+      best.mutable_slot(i).alive = false;
+      continue;
+    }
     const auto it = std::lower_bound(sorted.begin(), sorted.end(), s.lm.id,
                                      [](const auto& a, std::int64_t id) { return a.first < id; });
     if (it == sorted.end() || it->first != s.lm.id || !finite(it->second)) continue;

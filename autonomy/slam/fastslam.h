@@ -84,6 +84,7 @@
 // Single-threaded (use_count() decides copy on write).
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <random>
 #include <utility>
@@ -259,8 +260,11 @@ class FastSlam {
   const std::vector<std::pair<std::int64_t, Vec2>>& best_sightings() const { return best_sightings_; }
   // after a back end (the pose graph) re-estimated the highest-weight
   // particle's pose and some of its landmarks (by id): every particle becomes
-  // that particle, at `pose`, with those landmarks moved, equal weights
-  void reanchor(const Pose2& pose, const std::vector<std::pair<std::int64_t, Vec2>>& landmarks);
+  // that particle, at `pose`, with those landmarks moved, equal weights; the
+  // landmarks started by update `forget_from` or later are dropped (a
+  // relocalisation's: the lost frames' ghosts)
+  void reanchor(const Pose2& pose, const std::vector<std::pair<std::int64_t, Vec2>>& landmarks,
+                std::int64_t forget_from = std::numeric_limits<std::int64_t>::max());
 
  private:
   struct Slot {

@@ -37,7 +37,11 @@ Localisation::Localisation(const SlamParams& p, SlamMode mode, const Pose2& star
 }
 
 std::optional<hal::StateEstimate> Localisation::on_imu(const hal::Imu& m) {
-  if (ekf_.on_imu(m) != estimation::EkfStatus::Ok) return std::nullopt;
+  if (ekf_.on_imu(m) != estimation::EkfStatus::Ok) {
+    stats_.rejected_messages = static_cast<long>(ekf_.rejected());
+    stats_.last_fault = "an IMU sample refused (not finite or out of order)";
+    return std::nullopt;
+  }
   const estimation::VelocityEstimate e = ekf_.estimate();
   odom_.push_back({e.stamp, e.pose});
   while (!odom_.empty() && e.stamp - odom_.front().stamp > kOdometryHistory) odom_.pop_front();
@@ -54,8 +58,14 @@ std::optional<hal::StateEstimate> Localisation::on_imu(const hal::Imu& m) {
   return hal::StateEstimate{e.stamp, compose(correction_, e.pose), e.vx, e.vy, e.yaw_rate};
 }
 
-void Localisation::on_wheel_speeds(const hal::WheelSpeeds& m) { ekf_.on_wheel_speeds(m); }
-void Localisation::on_steering(const hal::SteeringAngle& m) { ekf_.on_steering(m); }
+void Localisation::on_wheel_speeds(const hal::WheelSpeeds& m) {
+  if (ekf_.on_wheel_speeds(m) != estimation::EkfStatus::Ok) stats_.last_fault = "wheel speeds refused (not finite or out of order)";
+  stats_.rejected_messages = static_cast<long>(ekf_.rejected());
+}
+void Localisation::on_steering(const hal::SteeringAngle& m) {
+  if (ekf_.on_steering(m) != estimation::EkfStatus::Ok) stats_.last_fault = "a steering angle refused (not finite or out of order)";
+  stats_.rejected_messages = static_cast<long>(ekf_.rejected());
+}
 
 void Localisation::on_detections(const hal::ConeDetections& d) {
   if (!fastslam_) return;
@@ -106,7 +116,10 @@ void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
     for (const hal::DetectedCone& c : d.cones) obs.push_back({c.position, c.color, c.colour_from_camera});
     fastslam_->update(obs);
     map_news_ = true;
-    if (mode_ == SlamMode::FastSlamGraph) {
+    lost_run_ = lost_in_frame() ? lost_run_ + 1 : 0;
+    if (lost_run_ > 0) ++stats_.lost_frames;
+    if (lost_run_ >= params_.relocalisation.lost_frames) relocalise_on(obs);
+    if (mode_ == SlamMode::FastSlamGraph && lost_run_ == 0) {
       const bool closure = closes_loop();
       record_node(odom, closure);
       if (closure) optimise_graph();
@@ -184,6 +197,50 @@ void Localisation::optimise_graph() {
   }
   stats_.optimise_ms.push_back(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+}
+
+bool Localisation::lost_in_frame() const {
+  const auto& seen = fastslam_->best_sightings();
+  const slam::RelocaliseParams& rp = params_.relocalisation;
+  if (static_cast<int>(seen.size()) < rp.lost_min_observations) return false;
+  // associated: with a landmark started before this update, and before the
+  // lost frames in a row so far (their observations started ghosts, which
+  // the next frame would associate with)
+  const std::int64_t now = fastslam_->updates() - 1 - lost_run_;
+  int associated = 0;
+  for (const auto& [id, point] : seen) associated += id >= 0 && id / slam::FastSlam::kIdsPerUpdate < now ? 1 : 0;
+  // with next to no map there is nothing to associate with
+  return fastslam_->map().size() >= seen.size() &&
+         static_cast<double>(associated) < rp.lost_ratio * static_cast<double>(seen.size());
+}
+
+void Localisation::relocalise_on(const std::vector<slam::Observation>& obs) {
+  // the map as it was before the car got lost: the landmarks the lost
+  // frames started are where the lost pose put them (ghosts of the cones it
+  // sees, which would fit the lost pose); tentative ones count (the far
+  // cones of the frame, seen a few times before)
+  const std::int64_t lost_since = fastslam_->updates() - lost_run_;
+  std::vector<Vec2> map, points;
+  for (const slam::Landmark& l : fastslam_->all_landmarks())
+    if (l.id / slam::FastSlam::kIdsPerUpdate < lost_since) map.push_back(l.mean);
+  for (const slam::Observation& o : obs)
+    if (finite(o.position)) points.push_back(o.position);
+  const std::optional<slam::Relocalisation> r =
+      slam::relocalise(map, points, fastslam_->pose(), params_.relocalisation);
+  if (!r) {
+    ++stats_.relocalisation_failures;
+    stats_.last_fault = "lost: no pose near the estimate fits the map";
+    return;
+  }
+  ++stats_.relocalisations;
+  stats_.last_fault = "lost: relocalised";
+  fastslam_->reanchor(r->pose, {}, lost_since);
+  lost_run_ = 0;
+  // the odometry's chain broke where the car was moved: the graph starts
+  // again from here, its first node held where the relocalisation put it
+  nodes_.clear();
+  sightings_.clear();
+  closure_nodes_.clear();
 }
 
 double Localisation::odometry_variance() const {

@@ -47,6 +47,7 @@
 #include "autonomy/slam/cone_map.h"
 #include "autonomy/slam/fastslam.h"
 #include "autonomy/slam/pose_graph.h"
+#include "autonomy/slam/relocalise.h"
 
 namespace paddock::stack {
 
@@ -85,6 +86,7 @@ struct SlamParams {
   // its noise models are FastSLAM's (filled by the localisation)
   slam::PoseGraphParams graph;
   LoopClosureParams loop_closure;
+  slam::RelocaliseParams relocalisation;
   // not visited: the runner fills them from the vehicle ([vehicle]) and the
   // scenario's seed
   estimation::CarGeometry geometry;
@@ -96,6 +98,7 @@ struct SlamParams {
     v.section(PADDOCK_PARAM(velocity), "the velocity and odometry EKF: IMU, wheel speeds, steering angle");
     v.section(PADDOCK_PARAM(graph), "the pose graph's solver and nodes (slam = fastslam_graph)");
     v.section(PADDOCK_PARAM(loop_closure), "when the pose graph is optimised (slam = fastslam_graph)");
+    v.section(PADDOCK_PARAM(relocalisation), "when the front end is lost, and the search for the pose that fits the map");
   }
 };
 
@@ -107,6 +110,10 @@ struct LocalisationStats {
   int loop_closures = 0;    // loop closures detected (each optimises the pose graph)
   int graph_failures = 0;   // optimisations that failed (the front end's estimate kept)
   std::vector<double> optimise_ms;  // wall time of each optimisation (inside its frame's update_ms)
+  long lost_frames = 0;     // frames the front end associated too little in (see RelocaliseParams)
+  int relocalisations = 0;  // the filter re-anchored where the frame fit the map
+  int relocalisation_failures = 0;  // searches that found no pose
+  long rejected_messages = 0;  // odometry messages the EKF refused (not finite, out of order)
   std::vector<double> update_ms;  // wall time of each SLAM update (not part of any result)
   std::string last_fault;   // the reason of the last fallback
 };
@@ -158,6 +165,9 @@ class Localisation {
   void record_node(const Pose2& odom, bool closure);
   bool closes_loop() const;
   void optimise_graph();
+  // the front end lost: relocalise on this frame
+  bool lost_in_frame() const;
+  void relocalise_on(const std::vector<slam::Observation>& obs);
 
   SlamParams params_;
   SlamMode mode_;
@@ -179,6 +189,7 @@ class Localisation {
   std::vector<Sighting> sightings_;
   std::int64_t start_updates_ = 0;       // landmarks started in updates before this one are the start's
   std::vector<int> closure_nodes_;       // the node of each closure
+  int lost_run_ = 0;                     // lost frames in a row
 };
 
 }  // namespace paddock::stack

@@ -148,6 +148,9 @@ SlamMetrics SlamScorer::metrics(const SimModel& model, const SimState& state, co
     m.frames = st.frames;
     m.fallbacks = st.empty_frames + st.dropped_frames;
     m.loop_closures = st.loop_closures;
+    m.lost_frames = st.lost_frames;
+    m.relocalisations = st.relocalisations;
+    m.rejected_messages = st.rejected_messages;
     double sum = 0.0;
     for (double x : st.update_ms) sum += x;
     m.update_ms_mean = st.update_ms.empty() ? 0.0 : sum / static_cast<double>(st.update_ms.size());

@@ -120,6 +120,9 @@ struct SlamMetrics {
   int loop_closures = 0;
   long frames = 0;                 // frames SLAM processed
   long fallbacks = 0;              // frames it could not use (no cone, no odometry)
+  long lost_frames = 0;            // frames the front end associated too little in
+  int relocalisations = 0;         // re-anchored where a frame fit the map
+  long rejected_messages = 0;      // odometry messages the EKF refused
   double update_ms_mean = 0.0, update_ms_p99 = 0.0;  // wall time of a SLAM update
   std::vector<SlamSample> series;  // every log sample, for the figures
 };

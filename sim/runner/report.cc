@@ -85,9 +85,10 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
     << fixed(100.0 * mm.precision, 1) << " %, recall " << fixed(100.0 * mm.recall, 1) << " % (of " << mm.true_cones
     << " within 5 m of the path), colour " << fixed(100.0 * mm.colour_accuracy, 1) << " %\n";
   if (s.autonomy.slam != stack::SlamMode::GroundTruth) {
-    o << "              " << r.slam.frames << " frames, " << r.slam.fallbacks << " unusable, " << r.slam.loop_closures
-      << " loop closures; update " << fixed(r.slam.update_ms_mean, 2) << " ms mean, " << fixed(r.slam.update_ms_p99, 2)
-      << " ms p99\n";
+    o << "              " << r.slam.frames << " frames, " << r.slam.fallbacks << " unusable, " << r.slam.lost_frames
+      << " lost, " << r.slam.relocalisations << " relocalisations, " << r.slam.rejected_messages
+      << " refused odometry messages, " << r.slam.loop_closures << " loop closures; update "
+      << fixed(r.slam.update_ms_mean, 2) << " ms mean, " << fixed(r.slam.update_ms_p99, 2) << " ms p99\n";
   }
   o << "  energy      " << fixed(r.energy / 3600.0, 1) << " Wh drawn from the accumulator over the run (regeneration counted off)\n";
   if (r.perception.frames() > 0) {
@@ -139,6 +140,9 @@ nlohmann::json slam_json(const Scenario& s, const SlamMetrics& m) {
           {"loop_closures", m.loop_closures},
           {"frames", m.frames},
           {"fallbacks", m.fallbacks},
+          {"lost_frames", m.lost_frames},
+          {"relocalisations", m.relocalisations},
+          {"rejected_messages", m.rejected_messages},
           {"update_ms_mean", m.update_ms_mean},
           {"update_ms_p99", m.update_ms_p99},
           {"laps", laps}};

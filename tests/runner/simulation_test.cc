@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <stdexcept>
 #include <thread>
@@ -237,6 +238,62 @@ TEST(Simulation, WithTheGraphTheLoopClosesAndTheMapImproves) {
   EXPECT_GE(graph.slam.map.precision, 0.98);
   EXPECT_GE(graph.slam.map.recall, 0.98);
   EXPECT_LT(graph.slam.ate_rms, 0.15);
+}
+
+// the worst position error of the estimate from t = 27 s to 45 s of an
+// autocross lap on the object-level sensor with slam = fastslam_graph; with
+// `kidnap`, 20 s in, on a straight, the car is lifted 2 m forward
+struct KidnapRun {
+  bool moved = false;
+  double worst_after = 0.0;
+  stack::LocalisationStats stats;
+  int fallbacks = 0, oc = 0;
+  bool dnf = false;
+};
+KidnapRun kidnap_run(bool kidnap) {
+  Scenario s = load_scenario(kRoot + "/scenarios/fsg_2023_autocross.ini", {"autonomy.perception=ground_truth"});
+  s.autonomy.slam = stack::SlamMode::FastSlamGraph;
+  const world::TrackModel track = world::build_track(load_track_file(s.track_path));
+  const SimModel model = compile_model(s, track);
+  SimState state(model);
+  KidnapRun out;
+  while (!state.done && state.t < 45.0) {
+    if (kidnap && !out.moved && state.t > 20.0 && std::abs(state.car.r) < 0.02 && state.car.vx > 5.0) {
+      state.car.x += 2.0 * std::cos(state.car.yaw);
+      state.car.y += 2.0 * std::sin(state.car.yaw);
+      out.moved = true;
+    }
+    step(model, state);
+    if (state.t > 27.0 && state.stack.estimate()) {
+      const hal::StateEstimate& e = *state.stack.estimate();
+      out.worst_after = std::max(out.worst_after, distance(e.pose.position(), state.true_poses.at(e.stamp).position()));
+    }
+  }
+  out.stats = state.stack.localisation()->stats();
+  out.fallbacks = state.stack.telemetry().fallbacks;
+  out.oc = state.event.result().oc;
+  out.dnf = !state.event.result().dnf_reason.empty();
+  return out;
+}
+
+TEST(Simulation, AKidnappedCarRelocalisesAndDrivesOn) {
+  // the odometry cannot see the kidnap; the front end finds its cones 2 m
+  // off, is lost (a status counted), relocalises on the map as it was before
+  // and drives on: 2 s later its error is what it is without a kidnap (the
+  // map's own error on this sensor reaches ~0.4 m late in the first lap),
+  // with no fallback and no excursion. (Measured: lost 3 frames, the
+  // relocalisation 2.0 m along the heading; the lost 0.3 s cost one cone.)
+  const KidnapRun calm = kidnap_run(false);
+  const KidnapRun k = kidnap_run(true);
+  ASSERT_TRUE(k.moved);
+  EXPECT_EQ(calm.stats.relocalisations, 0);
+  EXPECT_EQ(calm.stats.lost_frames, 0);
+  EXPECT_GE(k.stats.relocalisations, 1);
+  EXPECT_GT(k.stats.lost_frames, 0);
+  EXPECT_LT(k.worst_after, calm.worst_after + 0.2);
+  EXPECT_EQ(k.fallbacks, 0);
+  EXPECT_EQ(k.oc, 0);
+  EXPECT_FALSE(k.dnf);
 }
 
 TEST(Simulation, StreamSeedsDifferPerStream) {
