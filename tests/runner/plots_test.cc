@@ -116,7 +116,7 @@ TEST(Plots, SlamRunsWriteTheirSeriesAndTheSlamFigures) {
   EXPECT_EQ(worst, j.at("ate_max_m").get<double>());
   // the same folder run again with the true state: no SLAM series left behind
   ASSERT_EQ(paddock("run " + kRoot + "/scenarios/fsg_2023_trackdrive.ini --set autonomy.perception=ground_truth "
-                    "--set event.timeout=2 --out " + dir).code, 0);
+                    "--set autonomy.slam=ground_truth --set event.timeout=2 --out " + dir).code, 0);
   EXPECT_FALSE(fs::exists(dir + "/slam.csv"));
 }
 
