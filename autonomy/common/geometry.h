@@ -72,6 +72,11 @@ inline Pose2 between(const Pose2& a, const Pose2& b) {
   return {d.x, d.y, wrap_angle(b.yaw - a.yaw)};
 }
 
+// the pose a fraction f of the way from a to b (position linear, yaw on the circle)
+inline Pose2 interpolate(const Pose2& a, const Pose2& b, double f) {
+  return {a.x + f * (b.x - a.x), a.y + f * (b.y - a.y), wrap_angle(a.yaw + f * wrap_angle(b.yaw - a.yaw))};
+}
+
 // no NaN and no infinity in a value: the first check of every module's input
 inline bool finite(double v) { return std::isfinite(v); }
 inline bool finite(Vec2 p) { return std::isfinite(p.x) && std::isfinite(p.y); }

@@ -113,8 +113,7 @@ std::optional<Pose2> Stack::pose_at(TimeNs t) const {
   const hal::StateEstimate& a = history_[i - 1];
   const hal::StateEstimate& b = history_[i];
   const double f = b.stamp > a.stamp ? static_cast<double>(t - a.stamp) / static_cast<double>(b.stamp - a.stamp) : 1.0;
-  return Pose2{a.pose.x + f * (b.pose.x - a.pose.x), a.pose.y + f * (b.pose.y - a.pose.y),
-               wrap_angle(a.pose.yaw + f * wrap_angle(b.pose.yaw - a.pose.yaw))};
+  return interpolate(a.pose, b.pose, f);
 }
 
 void Stack::on_detections(const hal::ConeDetections& d) {
