@@ -66,16 +66,34 @@ double mahalanobis2(const Vector2d& nu, const Matrix2d& S) {
 
 ConeColor Landmark::color() const { return most_voted(votes); }
 
+void FastSlam::Bounds::cover(Vec2 m) {
+  lo_x = std::min(lo_x, m.x);
+  lo_y = std::min(lo_y, m.y);
+  hi_x = std::max(hi_x, m.x);
+  hi_y = std::max(hi_y, m.y);
+}
+
+double FastSlam::Bounds::squared_distance(Vec2 c) const {
+  // per axis the nearest edge's difference, computed as m - c is for a mean
+  // m in the box (fl(m - c) >= fl(lo - c) for m >= lo: the bound is exact)
+  const double lx = lo_x - c.x, hx = hi_x - c.x;
+  const double ly = lo_y - c.y, hy = hi_y - c.y;
+  const double dx = lx > 0.0 ? lx : (hx < 0.0 ? hx : 0.0);
+  const double dy = ly > 0.0 ? ly : (hy < 0.0 ? hy : 0.0);
+  return dx * dx + dy * dy;
+}
+
 FastSlam::Slot& FastSlam::Particle::mutable_slot(int i) {
-  std::shared_ptr<Block>& b = blocks[i / kLandmarkBlock];
+  std::shared_ptr<Block>& b = blocks[i / kLandmarkBlock].block;
   if (b.use_count() > 1) b = std::make_shared<Block>(*b);  // copy on write
   return b->slots[i % kLandmarkBlock];
 }
 
 int FastSlam::Particle::add(const Slot& s) {
-  if (size % kLandmarkBlock == 0) blocks.push_back(std::make_shared<Block>());
+  if (size % kLandmarkBlock == 0) blocks.push_back({std::make_shared<Block>(), Bounds{}});
   const int i = size++;
   mutable_slot(i) = s;
+  moved(i);
   return i;
 }
 
@@ -207,7 +225,10 @@ void FastSlam::gather_near(const Particle& p) {
   near_y_.clear();
   const double under2 = 0.25 * pr.min_range * pr.min_range;
   for (int b = 0; b * kLandmarkBlock < p.size; ++b) {
-    const Block& block = *p.blocks[static_cast<std::size_t>(b)];
+    const BlockRef& ref = p.blocks[static_cast<std::size_t>(b)];
+    // none of its landmarks within reach (most blocks: the car meets them in order)
+    if (ref.bounds.squared_distance(p.pose.position()) >= reach * reach) continue;
+    const Block& block = *ref.block;
     const int n = std::min(kLandmarkBlock, p.size - b * kLandmarkBlock);
     for (int j = 0; j < n; ++j) {
       const Slot& s = block.slots[static_cast<std::size_t>(j)];
@@ -313,6 +334,7 @@ void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<i
     const Matrix2d K = lm.cov * h.Hm.transpose() * S.inverse();
     const Vector2d dm = K * nu;
     lm.mean += Vec2{dm(0), dm(1)};
+    p.moved(match[k]);
     lm.cov = (Matrix2d::Identity() - K * h.Hm) * lm.cov;
     lm.cov = 0.5 * (lm.cov + lm.cov.transpose());
     ++lm.sightings;

@@ -275,14 +275,31 @@ class FastSlam {
   struct Block {
     std::array<Slot, kLandmarkBlock> slots;
   };
+  // a box holding every landmark mean a block has held (it only grows: a
+  // mean moves by centimetres, a dead slot stays in it); a block whose box
+  // is out of a frame's reach is skipped without reading it
+  struct Bounds {
+    double lo_x = std::numeric_limits<double>::infinity(), lo_y = std::numeric_limits<double>::infinity();
+    double hi_x = -std::numeric_limits<double>::infinity(), hi_y = -std::numeric_limits<double>::infinity();
+    void cover(Vec2 m);
+    // a lower bound of squared_norm(m - c) for every m in the box, in
+    // floating point too (each difference rounds monotonically)
+    double squared_distance(Vec2 c) const;
+  };
+  struct BlockRef {
+    std::shared_ptr<Block> block;  // shared between particles until written
+    Bounds bounds;                 // this particle's: copied with the pointer
+  };
   struct Particle {
     Pose2 pose;                                 // s^ until the update samples it
     Eigen::Matrix3d P = Eigen::Matrix3d::Zero();  // pose covariance since the last update
     double weight = 1.0;
-    std::vector<std::shared_ptr<Block>> blocks;  // shared between particles until written
+    std::vector<BlockRef> blocks;
     int size = 0;                                // slots used
-    const Slot& slot(int i) const { return blocks[i / kLandmarkBlock]->slots[i % kLandmarkBlock]; }
+    const Slot& slot(int i) const { return blocks[i / kLandmarkBlock].block->slots[i % kLandmarkBlock]; }
     Slot& mutable_slot(int i);                   // clones a shared block first
+    // after a write of slot i's mean: its block's bounds take it in
+    void moved(int i) { blocks[i / kLandmarkBlock].bounds.cover(slot(i).lm.mean); }
     int add(const Slot& s);
   };
   struct Frame;  // an update's prepared observations
