@@ -89,10 +89,21 @@ FastSlam::Slot& FastSlam::Particle::mutable_slot(int i) {
   return b->slots[i % kLandmarkBlock];
 }
 
+void FastSlam::Particle::kill(int i) {
+  BlockRef& ref = blocks[i / kLandmarkBlock];
+  ref.alive &= ~(1u << (i % kLandmarkBlock));
+  // nothing reads a dead slot: a block of dead ones need not be kept (or
+  // copied by a resample)
+  if (ref.alive == 0) ref.block.reset();
+}
+
 int FastSlam::Particle::add(const Slot& s) {
-  if (size % kLandmarkBlock == 0) blocks.push_back({std::make_shared<Block>(), Bounds{}});
+  if (size % kLandmarkBlock == 0) blocks.push_back({nullptr, Bounds{}, 0u});
+  BlockRef& ref = blocks.back();
+  if (!ref.block) ref.block = std::make_shared<Block>();  // new, or its slots so far all died
   const int i = size++;
   mutable_slot(i) = s;
+  blocks[i / kLandmarkBlock].alive |= 1u << (i % kLandmarkBlock);
   moved(i);
   return i;
 }
@@ -226,15 +237,16 @@ void FastSlam::gather_near(const Particle& p) {
   const double under2 = 0.25 * pr.min_range * pr.min_range;
   for (int b = 0; b * kLandmarkBlock < p.size; ++b) {
     const BlockRef& ref = p.blocks[static_cast<std::size_t>(b)];
+    if (ref.alive == 0) continue;
     // none of its landmarks within reach (most blocks: the car meets them in order)
     if (ref.bounds.squared_distance(p.pose.position()) >= reach * reach) continue;
-    const Block& block = *ref.block;
-    const int n = std::min(kLandmarkBlock, p.size - b * kLandmarkBlock);
-    for (int j = 0; j < n; ++j) {
-      const Slot& s = block.slots[static_cast<std::size_t>(j)];
+    // its alive slots, lowest first (the order of the indices)
+    for (std::uint32_t alive = ref.alive; alive != 0; alive &= alive - 1) {
+      const int j = __builtin_ctz(alive);
+      const Slot& s = ref.block->slots[static_cast<std::size_t>(j)];
       const double d2 = squared_norm(s.lm.mean - p.pose.position());
       // (one under the car has no stable bearing: neither scored nor expected)
-      if (s.alive && d2 < reach * reach && d2 > under2) {
+      if (d2 < reach * reach && d2 > under2) {
         near_.push_back(b * kLandmarkBlock + j);
         near_x_.push_back(s.lm.mean.x);
         near_y_.push_back(s.lm.mean.y);
@@ -364,7 +376,7 @@ void FastSlam::expect_and_remove(Particle& p, const std::vector<int>& taken) {
     const bool rare = s.lm.expected >= pr.remove_min_expected &&
                       static_cast<double>(s.lm.sightings) < pr.remove_ratio * static_cast<double>(s.lm.expected);
     const int misses = s.lm.confirmed ? pr.remove_misses : pr.remove_tentative_misses;
-    if (rare || s.misses >= misses) s.alive = false;
+    if (rare || s.misses >= misses) p.kill(i);
   }
 }
 
@@ -379,7 +391,6 @@ void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<
     const Observation& o = *f.obs[k];
     log_lik += log_p0;
     Slot s;
-    s.alive = true;
     s.lm.id = updates_ * kIdsPerUpdate + static_cast<std::int64_t>(k);
     ids[k] = s.lm.id;
     s.lm.mean = {p.pose.x + cy * o.position.x - sy * o.position.y, p.pose.y + sy * o.position.x + cy * o.position.y};
@@ -456,10 +467,10 @@ void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int6
   std::vector<std::pair<std::int64_t, Vec2>> sorted = landmarks;
   std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   for (int i = 0; i < best.size; ++i) {
+    if (!best.alive(i)) continue;
     const Slot& s = best.slot(i);
-    if (!s.alive) continue;
     if (s.lm.id / kIdsPerUpdate >= forget_from) {
-      best.mutable_slot(i).alive = false;
+      best.kill(i);
       continue;
     }
     const auto it = std::lower_bound(sorted.begin(), sorted.end(), s.lm.id,
@@ -480,8 +491,9 @@ std::vector<Landmark> FastSlam::landmarks(bool confirmed_only) const {
   const Particle& p = particles_[static_cast<std::size_t>(best_)];
   std::vector<Landmark> out;
   for (int i = 0; i < p.size; ++i) {
+    if (!p.alive(i)) continue;
     const Slot& s = p.slot(i);
-    if (s.alive && (s.lm.confirmed || !confirmed_only)) out.push_back(s.lm);
+    if (s.lm.confirmed || !confirmed_only) out.push_back(s.lm);
   }
   return out;
 }

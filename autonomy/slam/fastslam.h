@@ -270,7 +270,6 @@ class FastSlam {
   struct Slot {
     Landmark lm;
     int misses = 0;  // expected frames in a row without a sighting
-    bool alive = false;
   };
   struct Block {
     std::array<Slot, kLandmarkBlock> slots;
@@ -286,10 +285,17 @@ class FastSlam {
     // floating point too (each difference rounds monotonically)
     double squared_distance(Vec2 c) const;
   };
+  // a particle's view of one block: the pointer, the bounds of its means
+  // and which of its slots are alive (bit j: slot j), beside the pointer so
+  // that the search of nearby landmarks reads no dead slot: most slots die
+  // young (a ghost, a far cone seen once), and a particle gathers thousands
+  // of them over ten laps. A block whose slots are all dead is let go.
   struct BlockRef {
-    std::shared_ptr<Block> block;  // shared between particles until written
-    Bounds bounds;                 // this particle's: copied with the pointer
+    std::shared_ptr<Block> block;  // shared between particles until written; null when all dead
+    Bounds bounds;
+    std::uint32_t alive = 0;
   };
+  static_assert(kLandmarkBlock <= 32, "BlockRef::alive holds a block's slots");
   struct Particle {
     Pose2 pose;                                 // s^ until the update samples it
     Eigen::Matrix3d P = Eigen::Matrix3d::Zero();  // pose covariance since the last update
@@ -300,7 +306,9 @@ class FastSlam {
     Slot& mutable_slot(int i);                   // clones a shared block first
     // after a write of slot i's mean: its block's bounds take it in
     void moved(int i) { blocks[i / kLandmarkBlock].bounds.cover(slot(i).lm.mean); }
-    int add(const Slot& s);
+    bool alive(int i) const { return (blocks[i / kLandmarkBlock].alive >> (i % kLandmarkBlock)) & 1u; }
+    void kill(int i);                            // slot i is dead from now on (and never read again)
+    int add(const Slot& s);                      // a new alive slot
   };
   struct Frame;  // an update's prepared observations
 
