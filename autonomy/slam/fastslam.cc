@@ -42,6 +42,16 @@ Predicted predict_measurement(const Pose2& s, Vec2 m) {
   return p;
 }
 
+// H_m alone, as predict_measurement computes it
+Matrix2d landmark_jacobian(const Pose2& s, Vec2 m) {
+  const double dx = m.x - s.x, dy = m.y - s.y;
+  const double q = std::max(dx * dx + dy * dy, 1e-12);
+  const double r = std::sqrt(q);
+  Matrix2d Hm;
+  Hm << dx / r, dy / r, -dy / q, dx / q;
+  return Hm;
+}
+
 Vector2d innovation(const Vector2d& z, const Vector2d& zhat) {
   return {z(0) - zhat(0), wrap(z(1) - zhat(1))};
 }
@@ -108,13 +118,6 @@ int FastSlam::Particle::add(const Slot& s) {
   return i;
 }
 
-// the frame's valid observations as range, bearing and noise
-struct FastSlam::Frame {
-  std::vector<Vector2d> z;
-  std::vector<Matrix2d> R;
-  std::vector<const Observation*> obs;
-};
-
 FastSlam::FastSlam(const FastSlamParams& p, std::uint64_t seed)
     : params_(params::require_valid(p, "FastSlamParams")), rng_(seed) {
   reset(Pose2{});
@@ -175,11 +178,11 @@ Pose2 FastSlam::sample_pose(const Pose2& mean, const Matrix3d& cov) {
   return {mean.x + d(0), mean.y + d(1), wrap(mean.yaw + d(2))};
 }
 
-void FastSlam::update(const std::vector<Observation>& obs) {
-  Frame f;
-  f.z.reserve(obs.size());
-  f.R.reserve(obs.size());
-  f.obs.reserve(obs.size());
+void FastSlam::prepare(const std::vector<Observation>& obs) {
+  Frame& f = frame_;
+  f.z.clear();
+  f.R.clear();
+  f.obs.clear();
   for (const Observation& o : obs) {
     const double r = norm(o.position);
     if (!finite(o.position) || !(r >= params_.min_range) || static_cast<std::int64_t>(f.obs.size()) >= kIdsPerUpdate) {
@@ -191,12 +194,25 @@ void FastSlam::update(const std::vector<Observation>& obs) {
     f.R.push_back(Vector2d(sr * sr, params_.bearing_std * params_.bearing_std).asDiagonal());
     f.obs.push_back(&o);
   }
+  f.by_x.resize(f.obs.size());
+  for (std::size_t k = 0; k < f.by_x.size(); ++k) f.by_x[k] = static_cast<int>(k);
+  std::sort(f.by_x.begin(), f.by_x.end(), [&f](int a, int b) {
+    const double xa = f.obs[static_cast<std::size_t>(a)]->position.x, xb = f.obs[static_cast<std::size_t>(b)]->position.x;
+    return xa < xb || (xa == xb && a < b);
+  });
+  f.sorted_x.clear();
+  for (int k : f.by_x) f.sorted_x.push_back(f.obs[static_cast<std::size_t>(k)]->position.x);
+}
+
+void FastSlam::update(const std::vector<Observation>& obs) {
+  prepare(obs);
 
   // each particle: sample its pose, associate, update its map; log-likelihoods
   const std::size_t n = particles_.size();
-  std::vector<double> ll(n, 0.0);
+  std::vector<double>& ll = log_lik_;
+  ll.assign(n, 0.0);
   frame_ids_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) update_particle(particles_[i], f, ll[i], frame_ids_[i]);
+  for (std::size_t i = 0; i < n; ++i) update_particle(particles_[i], frame_, ll[i], frame_ids_[i]);
 
   // reweight (in logs, about the largest, against underflow) and normalise
   const double top = *std::max_element(ll.begin(), ll.end());
@@ -220,7 +236,7 @@ void FastSlam::update(const std::vector<Observation>& obs) {
   neff_ = 1.0 / sum2;
   best_sightings_.clear();
   const std::vector<std::int64_t>& ids = frame_ids_[static_cast<std::size_t>(best_)];
-  for (std::size_t k = 0; k < ids.size(); ++k) best_sightings_.emplace_back(ids[k], f.obs[k]->position);
+  for (std::size_t k = 0; k < ids.size(); ++k) best_sightings_.emplace_back(ids[k], frame_.obs[k]->position);
   ++updates_;
   if (neff_ < params_.resample_neff_ratio * static_cast<double>(n)) resample();
 }
@@ -255,57 +271,78 @@ void FastSlam::gather_near(const Particle& p) {
   }
 }
 
-std::vector<int> FastSlam::associate(const Particle& p, const Frame& f, std::vector<int>& taken) const {
-  // maximum likelihood per observation, within the gate and above the
-  // new-landmark likelihood, one observation per landmark (mutual exclusion)
+void FastSlam::find_candidates(const Particle& p, const Frame& f) {
+  // each near landmark against the observations landing within
+  // search_radius of it (at s^ for 2.0, at the sampled pose for 1.0),
+  // scored by likelihood within the gate and above the new-landmark one
   const FastSlamParams& pr = params_;
   const bool v2 = pr.fastslam_version == 2;
-  const std::size_t m = f.z.size();
   const double log_p0 = std::log(pr.new_landmark_likelihood);
-  // the pose's rotation (at s^ for 2.0, at the sampled pose for 1.0)
   const double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
-  // candidates: (log-likelihood, observation, landmark)
-  struct Cand {
-    double ll;
-    int obs;
-    int lm;
-  };
-  std::vector<Cand> cands;
-  const double r2 = pr.search_radius * pr.search_radius;
-  const Matrix2d assoc = pr.association_std * pr.association_std * Matrix2d::Identity();
+  const std::size_t m = f.z.size();
+  land_x_.resize(m);
+  land_y_.resize(m);
   for (std::size_t k = 0; k < m; ++k) {
     const Vec2 o = f.obs[k]->position;
-    const Vec2 w{p.pose.x + cy * o.x - sy * o.y, p.pose.y + sy * o.x + cy * o.y};
-    for (std::size_t j = 0; j < near_.size(); ++j) {
-      const double ex = near_x_[j] - w.x, ey = near_y_[j] - w.y;
+    land_x_[k] = p.pose.x + cy * o.x - sy * o.y;
+    land_y_[k] = p.pose.y + sy * o.x + cy * o.y;
+  }
+  // the observations to try, by their x in the base frame: within the
+  // radius of the landmark's x there, and a margin far above the rounding
+  // of the two frames (the distance test itself is the world frame's)
+  const double band = pr.search_radius + 1e-9 * (1.0 + pr.search_radius + std::abs(p.pose.x) + std::abs(p.pose.y));
+  const double r2 = pr.search_radius * pr.search_radius;
+  const Matrix2d assoc = pr.association_std * pr.association_std * Matrix2d::Identity();
+  cands_.clear();
+  for (std::size_t j = 0; j < near_.size(); ++j) {
+    const double bx = cy * (near_x_[j] - p.pose.x) + sy * (near_y_[j] - p.pose.y);
+    auto it = std::lower_bound(f.sorted_x.begin(), f.sorted_x.end(), bx - band);
+    // h, H_m C H_m^T and H_s P H_s^T: the landmark's, whichever observation
+    bool predicted = false;
+    Predicted h;
+    Matrix2d HCH, HPH;
+    for (; it != f.sorted_x.end() && *it <= bx + band; ++it) {
+      const std::size_t k = static_cast<std::size_t>(f.by_x[static_cast<std::size_t>(it - f.sorted_x.begin())]);
+      const double ex = near_x_[j] - land_x_[k], ey = near_y_[j] - land_y_[k];
       if (ex * ex + ey * ey > r2) continue;
-      const int i = near_[j];
-      const Slot& s = p.slot(i);
-      const Predicted h = predict_measurement(p.pose, s.lm.mean);
-      Matrix2d Z = h.Hm * (s.lm.cov + assoc) * h.Hm.transpose() + f.R[k];
-      if (v2) Z += h.Hs * p.P * h.Hs.transpose();
+      if (!predicted) {
+        const Slot& s = p.slot(near_[j]);
+        h = predict_measurement(p.pose, s.lm.mean);
+        HCH = h.Hm * (s.lm.cov + assoc) * h.Hm.transpose();
+        if (v2) HPH = h.Hs * p.P * h.Hs.transpose();
+        predicted = true;
+      }
+      Matrix2d Z = HCH + f.R[k];
+      if (v2) Z += HPH;
       const Vector2d nu = innovation(f.z[k], h.z);
       if (!(mahalanobis2(nu, Z) <= pr.association_gate)) continue;
       const double l = log_gauss(nu, Z, nullptr);
       if (!(l >= log_p0)) continue;
-      cands.push_back({l, static_cast<int>(k), i});
+      cands_.push_back({l, static_cast<int>(k), static_cast<int>(j)});
     }
   }
-  // mutual exclusion, best first (ties: the earlier observation, then landmark)
-  std::sort(cands.begin(), cands.end(), [](const Cand& a, const Cand& b) {
+}
+
+const std::vector<int>& FastSlam::associate(const Particle& p, const Frame& f) {
+  // maximum likelihood per observation, one observation per landmark
+  // (mutual exclusion): the candidates best first (ties: the earlier
+  // observation, then landmark; near_ is in index order)
+  find_candidates(p, f);
+  std::sort(cands_.begin(), cands_.end(), [](const Candidate& a, const Candidate& b) {
     if (a.ll != b.ll) return a.ll > b.ll;
     if (a.obs != b.obs) return a.obs < b.obs;
-    return a.lm < b.lm;
+    return a.near < b.near;
   });
-  std::vector<int> match(m, -1);
-  taken.clear();
-  for (const Cand& c : cands) {
-    if (match[static_cast<std::size_t>(c.obs)] >= 0) continue;
-    if (std::find(taken.begin(), taken.end(), c.lm) != taken.end()) continue;
-    match[static_cast<std::size_t>(c.obs)] = c.lm;
-    taken.push_back(c.lm);
+  match_.assign(f.z.size(), -1);
+  near_taken_.assign(near_.size(), 0);
+  for (const Candidate& c : cands_) {
+    int& match = match_[static_cast<std::size_t>(c.obs)];
+    char& taken = near_taken_[static_cast<std::size_t>(c.near)];
+    if (match >= 0 || taken) continue;
+    match = near_[static_cast<std::size_t>(c.near)];
+    taken = 1;
   }
-  return match;
+  return match_;
 }
 
 void FastSlam::propose_and_sample(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik) {
@@ -356,15 +393,16 @@ void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<i
   }
 }
 
-void FastSlam::expect_and_remove(Particle& p, const std::vector<int>& taken) {
+void FastSlam::expect_and_remove(Particle& p) {
   // expectations and removal of the landmarks that were there before this frame
   // (in view: |b| < view_range and |bearing| < view_half_fov <=> b_x > |b| cos(view_half_fov))
   const FastSlamParams& pr = params_;
   const double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
   const double cos_fov = std::cos(pr.view_half_fov);
-  for (int i : near_) {
+  for (std::size_t j = 0; j < near_.size(); ++j) {
+    const int i = near_[j];
     const Slot& cs = p.slot(i);
-    const bool seen = std::find(taken.begin(), taken.end(), i) != taken.end();
+    const bool seen = near_taken_[j] != 0;
     const Vec2 d = cs.lm.mean - p.pose.position();
     const Vec2 b{cy * d.x + sy * d.y, -sy * d.x + cy * d.y};
     const double b2 = squared_norm(b);
@@ -394,8 +432,7 @@ void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<
     s.lm.id = updates_ * kIdsPerUpdate + static_cast<std::int64_t>(k);
     ids[k] = s.lm.id;
     s.lm.mean = {p.pose.x + cy * o.position.x - sy * o.position.y, p.pose.y + sy * o.position.x + cy * o.position.y};
-    const Predicted h = predict_measurement(p.pose, s.lm.mean);
-    const Matrix2d Hinv = h.Hm.inverse();
+    const Matrix2d Hinv = landmark_jacobian(p.pose, s.lm.mean).inverse();
     s.lm.cov = Hinv * f.R[k] * Hinv.transpose();
     s.lm.sightings = 1;
     s.lm.expected = 1;
@@ -413,11 +450,10 @@ void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik, std
     p.P.setZero();
   }
   gather_near(p);
-  std::vector<int> taken;  // landmarks matched this frame
-  const std::vector<int> match = associate(p, f, taken);
+  const std::vector<int>& match = associate(p, f);
   if (v2) propose_and_sample(p, f, match, log_lik);
   update_landmarks(p, f, match, log_lik);
-  expect_and_remove(p, taken);
+  expect_and_remove(p);
   ids.assign(match.size(), -1);
   for (std::size_t k = 0; k < match.size(); ++k)
     if (match[k] >= 0) ids[k] = p.slot(match[k]).lm.id;

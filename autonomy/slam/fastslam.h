@@ -310,18 +310,36 @@ class FastSlam {
     void kill(int i);                            // slot i is dead from now on (and never read again)
     int add(const Slot& s);                      // a new alive slot
   };
-  struct Frame;  // an update's prepared observations
+  // an update's valid observations: range and bearing, noise, the
+  // observation; and their order along the base frame's x axis, the same
+  // for every particle (the association's search)
+  struct Frame {
+    std::vector<Eigen::Vector2d> z;
+    std::vector<Eigen::Matrix2d> R;
+    std::vector<const Observation*> obs;
+    std::vector<double> sorted_x;  // the observations' position.x, ascending
+    std::vector<int> by_x;         // their indices in that order
+  };
+  // an association candidate: log-likelihood, observation, position in near_
+  struct Candidate {
+    double ll;
+    int obs;
+    int near;
+  };
 
+  void prepare(const std::vector<Observation>& obs);  // into frame_
   void update_particle(Particle& p, const Frame& f, double& log_lik, std::vector<std::int64_t>& ids);
   // its parts, in order: the landmarks near the particle (into near_), the
-  // association (observation -> landmark or -1; the landmarks taken), the
-  // 2.0 proposal and the pose drawn from it, the associated landmarks'
-  // EKFs, the expectations and removals, the new tentative landmarks
+  // association (observation -> landmark or -1; near_taken_: the near
+  // landmarks taken), the 2.0 proposal and the pose drawn from it, the
+  // associated landmarks' EKFs, the expectations and removals, the new
+  // tentative landmarks
   void gather_near(const Particle& p);
-  std::vector<int> associate(const Particle& p, const Frame& f, std::vector<int>& taken) const;
+  const std::vector<int>& associate(const Particle& p, const Frame& f);
+  void find_candidates(const Particle& p, const Frame& f);  // into cands_
   void propose_and_sample(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
   void update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
-  void expect_and_remove(Particle& p, const std::vector<int>& taken);
+  void expect_and_remove(Particle& p);
   void add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik,
                          std::vector<std::int64_t>& ids);
   Pose2 sample_pose(const Pose2& mean, const Eigen::Matrix3d& cov);
@@ -337,9 +355,15 @@ class FastSlam {
   std::int64_t updates_ = 0;
   std::vector<std::vector<std::int64_t>> frame_ids_;  // per particle, per observation, this update
   std::vector<std::pair<std::int64_t, Vec2>> best_sightings_;
-  // scratch of update_particle (kept to spare the allocations)
+  // scratch of update and update_particle (kept to spare the allocations)
+  Frame frame_;
+  std::vector<double> log_lik_;
   std::vector<int> near_;
   std::vector<double> near_x_, near_y_;
+  std::vector<double> land_x_, land_y_;  // where the observations land
+  std::vector<Candidate> cands_;
+  std::vector<int> match_;
+  std::vector<char> near_taken_;
 };
 
 }  // namespace paddock::slam
