@@ -119,7 +119,7 @@ std::optional<Pose2> Stack::pose_at(TimeNs t) const {
 void Stack::on_detections(const hal::ConeDetections& d) {
   last_detections_ = d;
   ++detection_frames_;
-  // slam = fastslam: the map is SLAM's
+  // slam = fastslam or fastslam_graph: the map is SLAM's
   if (localisation_ && localisation_->owns_map()) {
     localisation_->on_detections(d);
     return;
