@@ -94,28 +94,33 @@ double FastSlam::Bounds::squared_distance(Vec2 c) const {
 }
 
 FastSlam::Slot& FastSlam::Particle::mutable_slot(int i) {
-  std::shared_ptr<Block>& b = blocks[i / kLandmarkBlock].block;
+  std::shared_ptr<Block>& b = blocks[i / kLandmarkBlock];
   if (b.use_count() > 1) b = std::make_shared<Block>(*b);  // copy on write
   return b->slots[i % kLandmarkBlock];
 }
 
-void FastSlam::Particle::kill(int i) {
-  BlockRef& ref = blocks[i / kLandmarkBlock];
-  ref.alive &= ~(1u << (i % kLandmarkBlock));
-  // nothing reads a dead slot: a block of dead ones need not be kept (or
-  // copied by a resample)
-  if (ref.alive == 0) ref.block.reset();
+int FastSlam::Particle::add(const Slot& s) {
+  const int i = size++;
+  const std::size_t b = static_cast<std::size_t>(i / kLandmarkBlock);
+  if (b == blocks.size()) blocks.emplace_back();
+  if (!blocks[b]) {
+    // a new block, or the last one again after its slots so far all died
+    blocks[b] = std::make_shared<Block>();
+    live.push_back({static_cast<int>(b), 0u, Bounds{}});
+  }
+  mutable_slot(i) = s;
+  LiveBlock& lb = live.back();  // the last block is the last live one
+  lb.alive |= 1u << (i % kLandmarkBlock);
+  lb.bounds.cover(s.lm.mean);
+  return i;
 }
 
-int FastSlam::Particle::add(const Slot& s) {
-  if (size % kLandmarkBlock == 0) blocks.push_back({nullptr, Bounds{}, 0u});
-  BlockRef& ref = blocks.back();
-  if (!ref.block) ref.block = std::make_shared<Block>();  // new, or its slots so far all died
-  const int i = size++;
-  mutable_slot(i) = s;
-  blocks[i / kLandmarkBlock].alive |= 1u << (i % kLandmarkBlock);
-  moved(i);
-  return i;
+void FastSlam::Particle::sweep() {
+  // nothing reads a dead slot: a block of dead ones need not be kept (or
+  // copied by a resample)
+  for (const LiveBlock& lb : live)
+    if (lb.alive == 0) blocks[static_cast<std::size_t>(lb.block)].reset();
+  live.erase(std::remove_if(live.begin(), live.end(), [](const LiveBlock& lb) { return lb.alive == 0; }), live.end());
 }
 
 FastSlam::FastSlam(const FastSlamParams& p, std::uint64_t seed)
@@ -248,22 +253,24 @@ void FastSlam::gather_near(const Particle& p) {
   const FastSlamParams& pr = params_;
   const double reach = std::max(pr.view_range, 0.0) + pr.search_radius;
   near_.clear();
+  near_live_.clear();
   near_x_.clear();
   near_y_.clear();
   const double under2 = 0.25 * pr.min_range * pr.min_range;
-  for (int b = 0; b * kLandmarkBlock < p.size; ++b) {
-    const BlockRef& ref = p.blocks[static_cast<std::size_t>(b)];
-    if (ref.alive == 0) continue;
+  for (std::size_t l = 0; l < p.live.size(); ++l) {
+    const LiveBlock& lb = p.live[l];
     // none of its landmarks within reach (most blocks: the car meets them in order)
-    if (ref.bounds.squared_distance(p.pose.position()) >= reach * reach) continue;
+    if (lb.bounds.squared_distance(p.pose.position()) >= reach * reach) continue;
     // its alive slots, lowest first (the order of the indices)
-    for (std::uint32_t alive = ref.alive; alive != 0; alive &= alive - 1) {
+    const Block& block = *p.blocks[static_cast<std::size_t>(lb.block)];
+    for (std::uint32_t alive = lb.alive; alive != 0; alive &= alive - 1) {
       const int j = __builtin_ctz(alive);
-      const Slot& s = ref.block->slots[static_cast<std::size_t>(j)];
+      const Slot& s = block.slots[static_cast<std::size_t>(j)];
       const double d2 = squared_norm(s.lm.mean - p.pose.position());
       // (one under the car has no stable bearing: neither scored nor expected)
       if (d2 < reach * reach && d2 > under2) {
-        near_.push_back(b * kLandmarkBlock + j);
+        near_.push_back(lb.block * kLandmarkBlock + j);
+        near_live_.push_back(static_cast<int>(l));
         near_x_.push_back(s.lm.mean.x);
         near_y_.push_back(s.lm.mean.y);
       }
@@ -339,7 +346,7 @@ const std::vector<int>& FastSlam::associate(const Particle& p, const Frame& f) {
     int& match = match_[static_cast<std::size_t>(c.obs)];
     char& taken = near_taken_[static_cast<std::size_t>(c.near)];
     if (match >= 0 || taken) continue;
-    match = near_[static_cast<std::size_t>(c.near)];
+    match = c.near;
     taken = 1;
   }
   return match_;
@@ -352,7 +359,7 @@ void FastSlam::propose_and_sample(Particle& p, const Frame& f, const std::vector
   Matrix3d Sigma = p.P;
   for (std::size_t k = 0; k < f.z.size(); ++k) {
     if (match[k] < 0) continue;
-    const Slot& s = p.slot(match[k]);
+    const Slot& s = p.slot(near_[static_cast<std::size_t>(match[k])]);
     const Pose2 at{mu(0), mu(1), mu(2)};
     const Predicted h = predict_measurement(at, s.lm.mean);
     const Matrix2d Z = h.Hs * Sigma * h.Hs.transpose() + h.Hm * s.lm.cov * h.Hm.transpose() + f.R[k];
@@ -374,7 +381,8 @@ void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<i
   for (std::size_t k = 0; k < f.z.size(); ++k) {
     if (match[k] < 0) continue;
     const Observation& o = *f.obs[k];
-    Slot& s = p.mutable_slot(match[k]);
+    const std::size_t j = static_cast<std::size_t>(match[k]);
+    Slot& s = p.mutable_slot(near_[j]);
     Landmark& lm = s.lm;
     const Predicted h = predict_measurement(p.pose, lm.mean);
     const Matrix2d S = h.Hm * lm.cov * h.Hm.transpose() + f.R[k];
@@ -383,7 +391,7 @@ void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<i
     const Matrix2d K = lm.cov * h.Hm.transpose() * S.inverse();
     const Vector2d dm = K * nu;
     lm.mean += Vec2{dm(0), dm(1)};
-    p.moved(match[k]);
+    p.live[static_cast<std::size_t>(near_live_[j])].bounds.cover(lm.mean);
     lm.cov = (Matrix2d::Identity() - K * h.Hm) * lm.cov;
     lm.cov = 0.5 * (lm.cov + lm.cov.transpose());
     ++lm.sightings;
@@ -401,21 +409,24 @@ void FastSlam::expect_and_remove(Particle& p) {
   const double cos_fov = std::cos(pr.view_half_fov);
   for (std::size_t j = 0; j < near_.size(); ++j) {
     const int i = near_[j];
-    const Slot& cs = p.slot(i);
     const bool seen = near_taken_[j] != 0;
-    const Vec2 d = cs.lm.mean - p.pose.position();
-    const Vec2 b{cy * d.x + sy * d.y, -sy * d.x + cy * d.y};
-    const double b2 = squared_norm(b);
-    const bool in_view = b2 < pr.view_range * pr.view_range && b.x > std::sqrt(b2) * cos_fov;
-    if (!seen && !in_view) continue;
+    if (!seen) {
+      // (its mean is still near_'s copy: only the seen ones have moved)
+      const Vec2 d = Vec2{near_x_[j], near_y_[j]} - p.pose.position();
+      const Vec2 b{cy * d.x + sy * d.y, -sy * d.x + cy * d.y};
+      const double b2 = squared_norm(b);
+      const bool in_view = b2 < pr.view_range * pr.view_range && b.x > std::sqrt(b2) * cos_fov;
+      if (!in_view) continue;
+    }
     Slot& s = p.mutable_slot(i);
     ++s.lm.expected;
     if (!seen) ++s.misses;
     const bool rare = s.lm.expected >= pr.remove_min_expected &&
                       static_cast<double>(s.lm.sightings) < pr.remove_ratio * static_cast<double>(s.lm.expected);
     const int misses = s.lm.confirmed ? pr.remove_misses : pr.remove_tentative_misses;
-    if (rare || s.misses >= misses) p.kill(i);
+    if (rare || s.misses >= misses) p.live[static_cast<std::size_t>(near_live_[j])].alive &= ~(1u << (i % kLandmarkBlock));
   }
+  p.sweep();
 }
 
 void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik,
@@ -526,10 +537,11 @@ Pose2 FastSlam::pose() const {
 std::vector<Landmark> FastSlam::landmarks(bool confirmed_only) const {
   const Particle& p = particles_[static_cast<std::size_t>(best_)];
   std::vector<Landmark> out;
-  for (int i = 0; i < p.size; ++i) {
-    if (!p.alive(i)) continue;
-    const Slot& s = p.slot(i);
-    if (s.lm.confirmed || !confirmed_only) out.push_back(s.lm);
+  for (const LiveBlock& lb : p.live) {
+    for (std::uint32_t alive = lb.alive; alive != 0; alive &= alive - 1) {
+      const Slot& s = p.slot(lb.block * kLandmarkBlock + __builtin_ctz(alive));
+      if (s.lm.confirmed || !confirmed_only) out.push_back(s.lm);
+    }
   }
   return out;
 }

@@ -285,30 +285,31 @@ class FastSlam {
     // floating point too (each difference rounds monotonically)
     double squared_distance(Vec2 c) const;
   };
-  // a particle's view of one block: the pointer, the bounds of its means
-  // and which of its slots are alive (bit j: slot j), beside the pointer so
-  // that the search of nearby landmarks reads no dead slot: most slots die
-  // young (a ghost, a far cone seen once), and a particle gathers thousands
-  // of them over ten laps. A block whose slots are all dead is let go.
-  struct BlockRef {
-    std::shared_ptr<Block> block;  // shared between particles until written; null when all dead
+  // a block with an alive slot, as a particle sees it: its number, which
+  // of its slots are alive (bit j: slot j) and the bounds of its means. A
+  // particle's live blocks are a short list beside its block pointers: most
+  // slots die young (a ghost, a far cone seen once), a particle gathers
+  // thousands of them over ten laps, and the search of nearby landmarks
+  // reads neither their blocks nor their slots. A block whose slots have
+  // all died is let go.
+  struct LiveBlock {
+    int block;
+    std::uint32_t alive;
     Bounds bounds;
-    std::uint32_t alive = 0;
   };
-  static_assert(kLandmarkBlock <= 32, "BlockRef::alive holds a block's slots");
+  static_assert(kLandmarkBlock <= 32, "LiveBlock::alive holds a block's slots");
   struct Particle {
     Pose2 pose;                                 // s^ until the update samples it
     Eigen::Matrix3d P = Eigen::Matrix3d::Zero();  // pose covariance since the last update
     double weight = 1.0;
-    std::vector<BlockRef> blocks;
+    // by number: shared between particles until written; null once its slots all died
+    std::vector<std::shared_ptr<Block>> blocks;
+    std::vector<LiveBlock> live;                 // the blocks not null, by number
     int size = 0;                                // slots used
-    const Slot& slot(int i) const { return blocks[i / kLandmarkBlock].block->slots[i % kLandmarkBlock]; }
+    const Slot& slot(int i) const { return blocks[i / kLandmarkBlock]->slots[i % kLandmarkBlock]; }
     Slot& mutable_slot(int i);                   // clones a shared block first
-    // after a write of slot i's mean: its block's bounds take it in
-    void moved(int i) { blocks[i / kLandmarkBlock].bounds.cover(slot(i).lm.mean); }
-    bool alive(int i) const { return (blocks[i / kLandmarkBlock].alive >> (i % kLandmarkBlock)) & 1u; }
-    void kill(int i);                            // slot i is dead from now on (and never read again)
     int add(const Slot& s);                      // a new alive slot
+    void sweep();                                // lets go of the live blocks with no alive slot left
   };
   // an update's valid observations: range and bearing, noise, the
   // observation; and their order along the base frame's x axis, the same
@@ -330,8 +331,8 @@ class FastSlam {
   void prepare(const std::vector<Observation>& obs);  // into frame_
   void update_particle(Particle& p, const Frame& f, double& log_lik, std::vector<std::int64_t>& ids);
   // its parts, in order: the landmarks near the particle (into near_), the
-  // association (observation -> landmark or -1; near_taken_: the near
-  // landmarks taken), the 2.0 proposal and the pose drawn from it, the
+  // association (observation -> position in near_ or -1; near_taken_:
+  // the near landmarks taken), the 2.0 proposal and the pose drawn from it, the
   // associated landmarks' EKFs, the expectations and removals, the new
   // tentative landmarks
   void gather_near(const Particle& p);
@@ -358,7 +359,8 @@ class FastSlam {
   // scratch of update and update_particle (kept to spare the allocations)
   Frame frame_;
   std::vector<double> log_lik_;
-  std::vector<int> near_;
+  std::vector<int> near_;       // the landmarks' indices, ascending
+  std::vector<int> near_live_;  // their blocks' positions in Particle::live
   std::vector<double> near_x_, near_y_;
   std::vector<double> land_x_, land_y_;  // where the observations land
   std::vector<Candidate> cands_;
