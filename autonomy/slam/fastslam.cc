@@ -21,8 +21,22 @@ using Matrix23 = Eigen::Matrix<double, 2, 3>;
 constexpr double kLog2Pi = 1.8378770664093453;  // log(2 pi)
 constexpr double kMaxDelta = 1000.0;             // m: more in one predict is no odometry
 
-// wrap_angle without its fmod for the angles already in [-pi, pi) (nearly all)
-double wrap(double a) { return a >= -kPi && a < kPi ? a : wrap_angle(a); }
+// wrap_angle without its fmod for the angles already in [-pi, pi) (nearly
+// all), and wrap_angle's result without its fmod for those within a turn of
+// it (a bearing difference across +-pi: ~10 per particle and frame): there
+// fmod(t, 2 pi) is t or t - 2 pi, both exact (Sterbenz), as fmod is
+double wrap(double a) {
+  if (a >= -kPi && a < kPi) return a;
+  const double turn = 2.0 * kPi;
+  double t = a + kPi;
+  if (t >= turn && t < 2.0 * turn) {
+    t -= turn;
+  } else if (!(t > -turn && t < turn)) {
+    return wrap_angle(a);
+  }
+  if (t < 0.0) t += turn;  // as wrap_angle, from here on
+  return t - kPi;
+}
 
 // h(s, m) and its Jacobians (see the header)
 struct Predicted {
@@ -56,14 +70,21 @@ Vector2d innovation(const Vector2d& z, const Vector2d& zhat) {
   return {z(0) - zhat(0), wrap(z(1) - zhat(1))};
 }
 
-// log N(nu; 0, S) and the squared Mahalanobis distance
-double log_gauss(const Vector2d& nu, const Matrix2d& S, double* d2_out) {
+// N(nu; 0, S) in its parts: the squared Mahalanobis distance and det S
+struct GaussTerms {
+  double d2, det;
+};
+
+GaussTerms gauss_terms(const Vector2d& nu, const Matrix2d& S) {
   const double det = S.determinant();
   const Vector2d Sinv_nu = S.inverse() * nu;
-  const double d2 = nu.dot(Sinv_nu);
-  if (d2_out) *d2_out = d2;
-  return -0.5 * d2 - kLog2Pi - 0.5 * std::log(det);
+  return {nu.dot(Sinv_nu), det};
 }
+
+double log_gauss(const GaussTerms& g) { return -0.5 * g.d2 - kLog2Pi - 0.5 * std::log(g.det); }
+
+// log N(nu; 0, S)
+double log_gauss(const Vector2d& nu, const Matrix2d& S) { return log_gauss(gauss_terms(nu, S)); }
 
 // the squared Mahalanobis distance alone (the gate, before any log)
 double mahalanobis2(const Vector2d& nu, const Matrix2d& S) {
@@ -207,6 +228,11 @@ void FastSlam::prepare(const std::vector<Observation>& obs) {
   });
   f.sorted_x.clear();
   for (int k : f.by_x) f.sorted_x.push_back(f.obs[static_cast<std::size_t>(k)]->position.x);
+  // log N = -d2 / 2 - log(2 pi) - log(det) / 2 >= log(p0) for any d2 within
+  // the gate when det <= this (a margin of 1e-6 in the log, far above its
+  // rounding): the association needs no log to know it
+  const double log_p0 = std::log(params_.new_landmark_likelihood);
+  f.det_sure = std::exp(-2.0 * (log_p0 + kLog2Pi) - params_.association_gate - 1e-6);
 }
 
 void FastSlam::update(const std::vector<Observation>& obs) {
@@ -323,9 +349,15 @@ void FastSlam::find_candidates(const Particle& p, const Frame& f) {
       if (v2) Z += HPH;
       const Vector2d nu = innovation(f.z[k], h.z);
       if (!(mahalanobis2(nu, Z) <= pr.association_gate)) continue;
-      const double l = log_gauss(nu, Z, nullptr);
-      if (!(l >= log_p0)) continue;
-      cands_.push_back({l, static_cast<int>(k), static_cast<int>(j)});
+      const GaussTerms g = gauss_terms(nu, Z);
+      Candidate c{0.0, g.d2, g.det, static_cast<int>(k), static_cast<int>(j), false};
+      if (!(g.det > 0.0 && g.det <= f.det_sure && g.d2 <= pr.association_gate)) {
+        // not sure to be likelier than a new landmark: the log decides
+        c.ll = log_gauss(g);
+        c.scored = true;
+        if (!(c.ll >= log_p0)) continue;
+      }
+      cands_.push_back(c);
     }
   }
 }
@@ -333,16 +365,35 @@ void FastSlam::find_candidates(const Particle& p, const Frame& f) {
 const std::vector<int>& FastSlam::associate(const Particle& p, const Frame& f) {
   // maximum likelihood per observation, one observation per landmark
   // (mutual exclusion): the candidates best first (ties: the earlier
-  // observation, then landmark; near_ is in index order)
+  // observation, then landmark; near_ is in index order). A candidate alone
+  // on its observation and on its landmark (most) is taken whatever its
+  // likelihood; only its rivals need ranking, their own among them.
   find_candidates(p, f);
-  std::sort(cands_.begin(), cands_.end(), [](const Candidate& a, const Candidate& b) {
+  const std::size_t m = f.z.size();
+  cands_per_obs_.assign(m, 0);
+  cands_per_near_.assign(near_.size(), 0);
+  for (const Candidate& c : cands_) {
+    ++cands_per_obs_[static_cast<std::size_t>(c.obs)];
+    ++cands_per_near_[static_cast<std::size_t>(c.near)];
+  }
+  match_.assign(m, -1);
+  near_taken_.assign(near_.size(), 0);
+  rivals_.clear();
+  for (Candidate& c : cands_) {
+    if (cands_per_obs_[static_cast<std::size_t>(c.obs)] == 1 && cands_per_near_[static_cast<std::size_t>(c.near)] == 1) {
+      match_[static_cast<std::size_t>(c.obs)] = c.near;
+      near_taken_[static_cast<std::size_t>(c.near)] = 1;
+      continue;
+    }
+    if (!c.scored) c.ll = log_gauss(GaussTerms{c.d2, c.det});
+    rivals_.push_back(c);
+  }
+  std::sort(rivals_.begin(), rivals_.end(), [](const Candidate& a, const Candidate& b) {
     if (a.ll != b.ll) return a.ll > b.ll;
     if (a.obs != b.obs) return a.obs < b.obs;
     return a.near < b.near;
   });
-  match_.assign(f.z.size(), -1);
-  near_taken_.assign(near_.size(), 0);
-  for (const Candidate& c : cands_) {
+  for (const Candidate& c : rivals_) {
     int& match = match_[static_cast<std::size_t>(c.obs)];
     char& taken = near_taken_[static_cast<std::size_t>(c.near)];
     if (match >= 0 || taken) continue;
@@ -364,7 +415,7 @@ void FastSlam::propose_and_sample(Particle& p, const Frame& f, const std::vector
     const Predicted h = predict_measurement(at, s.lm.mean);
     const Matrix2d Z = h.Hs * Sigma * h.Hs.transpose() + h.Hm * s.lm.cov * h.Hm.transpose() + f.R[k];
     const Vector2d nu = innovation(f.z[k], h.z);
-    log_lik += log_gauss(nu, Z, nullptr);
+    log_lik += log_gauss(nu, Z);
     const Eigen::Matrix<double, 3, 2> Ks = Sigma * h.Hs.transpose() * Z.inverse();
     mu += Ks * nu;
     mu(2) = wrap(mu(2));
@@ -387,7 +438,7 @@ void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<i
     const Predicted h = predict_measurement(p.pose, lm.mean);
     const Matrix2d S = h.Hm * lm.cov * h.Hm.transpose() + f.R[k];
     const Vector2d nu = innovation(f.z[k], h.z);
-    if (pr.fastslam_version != 2) log_lik += log_gauss(nu, S, nullptr);
+    if (pr.fastslam_version != 2) log_lik += log_gauss(nu, S);
     const Matrix2d K = lm.cov * h.Hm.transpose() * S.inverse();
     const Vector2d dm = K * nu;
     lm.mean += Vec2{dm(0), dm(1)};
@@ -407,6 +458,7 @@ void FastSlam::expect_and_remove(Particle& p) {
   const FastSlamParams& pr = params_;
   const double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
   const double cos_fov = std::cos(pr.view_half_fov);
+  bool died = false;
   for (std::size_t j = 0; j < near_.size(); ++j) {
     const int i = near_[j];
     const bool seen = near_taken_[j] != 0;
@@ -424,9 +476,12 @@ void FastSlam::expect_and_remove(Particle& p) {
     const bool rare = s.lm.expected >= pr.remove_min_expected &&
                       static_cast<double>(s.lm.sightings) < pr.remove_ratio * static_cast<double>(s.lm.expected);
     const int misses = s.lm.confirmed ? pr.remove_misses : pr.remove_tentative_misses;
-    if (rare || s.misses >= misses) p.live[static_cast<std::size_t>(near_live_[j])].alive &= ~(1u << (i % kLandmarkBlock));
+    if (rare || s.misses >= misses) {
+      p.live[static_cast<std::size_t>(near_live_[j])].alive &= ~(1u << (i % kLandmarkBlock));
+      died = true;
+    }
   }
-  p.sweep();
+  if (died) p.sweep();
 }
 
 void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik,

@@ -320,12 +320,16 @@ class FastSlam {
     std::vector<const Observation*> obs;
     std::vector<double> sorted_x;  // the observations' position.x, ascending
     std::vector<int> by_x;         // their indices in that order
+    double det_sure = 0.0;         // an association candidate's det S below which it is surely likelier than p0
   };
-  // an association candidate: log-likelihood, observation, position in near_
+  // an association candidate: its log-likelihood (once scored) and its
+  // parts, observation, position in near_
   struct Candidate {
     double ll;
+    double d2, det;
     int obs;
     int near;
+    bool scored;
   };
 
   void prepare(const std::vector<Observation>& obs);  // into frame_
@@ -363,7 +367,8 @@ class FastSlam {
   std::vector<int> near_live_;  // their blocks' positions in Particle::live
   std::vector<double> near_x_, near_y_;
   std::vector<double> land_x_, land_y_;  // where the observations land
-  std::vector<Candidate> cands_;
+  std::vector<Candidate> cands_, rivals_;
+  std::vector<int> cands_per_obs_, cands_per_near_;
   std::vector<int> match_;
   std::vector<char> near_taken_;
 };
