@@ -363,6 +363,7 @@ class FastSlam {
   // scratch of update and update_particle (kept to spare the allocations)
   Frame frame_;
   std::vector<double> log_lik_;
+  std::vector<int> in_reach_;   // live blocks (positions) within reach
   std::vector<int> near_;       // the landmarks' indices, ascending
   std::vector<int> near_live_;  // their blocks' positions in Particle::live
   std::vector<double> near_x_, near_y_;
