@@ -546,8 +546,7 @@ void FastSlam::resample() {
   const double step = 1.0 / static_cast<double>(n);
   std::uniform_real_distribution<double> u01(0.0, step);
   const double r = u01(rng_);
-  std::vector<Particle> next;
-  next.reserve(n);
+  picks_.resize(n);
   int new_best = -1;
   double c = particles_[0].weight;
   std::size_t i = 0;
@@ -555,16 +554,33 @@ void FastSlam::resample() {
     const double u = r + static_cast<double>(k) * step;
     while (u > c && i + 1 < n) c += particles_[++i].weight;
     if (new_best < 0 && static_cast<int>(i) == best_) new_best = static_cast<int>(k);
-    next.push_back(particles_[i]);
-    next.back().weight = step;
+    picks_[k] = static_cast<int>(i);
   }
   if (new_best < 0) {
     // the best particle always survives (its weight >= 1/N); keep it if rounding says otherwise
-    next[0] = particles_[static_cast<std::size_t>(best_)];
-    next[0].weight = step;
+    picks_[0] = best_;
     new_best = 0;
   }
-  particles_ = std::move(next);
+  // into the spare set (its vectors keep their capacity): a parent's copies
+  // are consecutive, its last one takes it over (no copy of its block
+  // pointers, no count of references up and down again)
+  spare_.resize(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    Particle& parent = particles_[static_cast<std::size_t>(picks_[k])];
+    if (k + 1 == n || picks_[k + 1] != picks_[k]) {
+      spare_[k] = std::move(parent);
+    } else {
+      spare_[k] = parent;
+    }
+    spare_[k].weight = step;
+  }
+  particles_.swap(spare_);
+  // the old set lets go of its blocks (a block held there would be cloned
+  // on its next write for nothing)
+  for (Particle& old : spare_) {
+    old.blocks.clear();
+    old.live.clear();
+  }
   best_ = new_best;
   ++resamples_;
 }

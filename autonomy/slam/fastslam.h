@@ -360,6 +360,9 @@ class FastSlam {
   std::int64_t updates_ = 0;
   std::vector<std::vector<std::int64_t>> frame_ids_;  // per particle, per observation, this update
   std::vector<std::pair<std::int64_t, Vec2>> best_sightings_;
+  // scratch of resample: the parent of each new particle, the new set
+  std::vector<int> picks_;
+  std::vector<Particle> spare_;
   // scratch of update and update_particle (kept to spare the allocations)
   Frame frame_;
   std::vector<double> log_lik_;
