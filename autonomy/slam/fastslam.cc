@@ -155,6 +155,7 @@ void FastSlam::reset(const Pose2& pose) {
   for (Particle& p : particles_) {
     p.pose = {pose.x, pose.y, wrap_angle(pose.yaw)};
     p.weight = w;
+    p.copy_of = 0;  // all alike
   }
   best_ = 0;
   neff_ = params_.particles;
@@ -243,7 +244,12 @@ void FastSlam::update(const std::vector<Observation>& obs) {
   std::vector<double>& ll = log_lik_;
   ll.assign(n, 0.0);
   frame_ids_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) update_particle(particles_[i], frame_, ll[i], frame_ids_[i]);
+  for (std::size_t i = 0; i < n; ++i) {
+    const int parent = particles_[i].copy_of;
+    update_particle(particles_[i], frame_, parent >= 0 && i > 0 && particles_[i - 1].copy_of == parent, ll[i],
+                    frame_ids_[i]);
+  }
+  for (Particle& p : particles_) p.copy_of = -1;  // each drew its own pose
 
   // reweight (in logs, about the largest, against underflow) and normalise
   const double top = *std::max_element(ll.begin(), ll.end());
@@ -417,11 +423,12 @@ const std::vector<int>& FastSlam::associate(const Particle& p, const Frame& f) {
   return match_;
 }
 
-void FastSlam::propose_and_sample(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik) {
+void FastSlam::propose(const Particle& p, const Frame& f, const std::vector<int>& match) {
   // FastSLAM 2.0: fold the associated observations into the pose's proposal,
-  // weigh by each one's likelihood given the ones before, then sample
+  // weigh by each one's likelihood given the ones before (into proposal_)
   Vector3d mu(p.pose.x, p.pose.y, p.pose.yaw);
   Matrix3d Sigma = p.P;
+  double log_lik = 0.0;
   for (std::size_t k = 0; k < f.z.size(); ++k) {
     if (match[k] < 0) continue;
     const Slot& s = p.slot(near_[static_cast<std::size_t>(match[k])]);
@@ -436,8 +443,7 @@ void FastSlam::propose_and_sample(Particle& p, const Frame& f, const std::vector
     Sigma -= Ks * Z * Ks.transpose();
     Sigma = 0.5 * (Sigma + Sigma.transpose());
   }
-  p.pose = sample_pose({mu(0), mu(1), mu(2)}, Sigma);
-  p.P.setZero();
+  proposal_ = {{mu(0), mu(1), mu(2)}, Sigma, log_lik};
 }
 
 void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik) {
@@ -522,22 +528,33 @@ void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<
   }
 }
 
-void FastSlam::update_particle(Particle& p, const Frame& f, double& log_lik, std::vector<std::int64_t>& ids) {
+void FastSlam::update_particle(Particle& p, const Frame& f, bool copy_of_previous, double& log_lik,
+                               std::vector<std::int64_t>& ids) {
   const bool v2 = params_.fastslam_version == 2;
   // FastSLAM 1.0: the pose from the motion model before anything else
   if (!v2) {
     p.pose = sample_pose(p.pose, p.P);
     p.P.setZero();
   }
-  gather_near(p);
-  const std::vector<int>& match = associate(p, f);
-  if (v2) propose_and_sample(p, f, match, log_lik);
-  update_landmarks(p, f, match, log_lik);
+  // (2.0) an unchanged copy of the particle before it finds the same
+  // landmarks near, the same association and the same proposal
+  if (!(v2 && copy_of_previous)) {
+    gather_near(p);
+    associate(p, f);
+    if (v2) propose(p, f, match_);
+  }
+  if (v2) {
+    log_lik += proposal_.log_lik;
+    p.pose = sample_pose(proposal_.mean, proposal_.cov);
+    p.P.setZero();
+  }
+  // the associated landmarks' ids, before a removal may let their block go
+  ids.assign(match_.size(), -1);
+  for (std::size_t k = 0; k < match_.size(); ++k)
+    if (match_[k] >= 0) ids[k] = p.slot(near_[static_cast<std::size_t>(match_[k])]).lm.id;  // match_: positions in near_
+  update_landmarks(p, f, match_, log_lik);
   expect_and_remove(p);
-  ids.assign(match.size(), -1);
-  for (std::size_t k = 0; k < match.size(); ++k)
-    if (match[k] >= 0) ids[k] = p.slot(match[k]).lm.id;
-  add_new_landmarks(p, f, match, log_lik, ids);
+  add_new_landmarks(p, f, match_, log_lik, ids);
 }
 
 void FastSlam::resample() {
@@ -573,6 +590,7 @@ void FastSlam::resample() {
       spare_[k] = parent;
     }
     spare_[k].weight = step;
+    spare_[k].copy_of = picks_[k];
   }
   particles_.swap(spare_);
   // the old set lets go of its blocks (a block held there would be cloned
@@ -595,21 +613,29 @@ void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int6
   best.pose = pose;
   best.P.setZero();
   best.weight = 1.0 / static_cast<double>(particles_.size());
-  // id -> position, then one pass over the particle's slots
+  best.copy_of = -1;
+  // id -> position, then one pass over the particle's alive slots
   std::vector<std::pair<std::int64_t, Vec2>> sorted = landmarks;
   std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  for (int i = 0; i < best.size; ++i) {
-    if (!best.alive(i)) continue;
-    const Slot& s = best.slot(i);
-    if (s.lm.id / kIdsPerUpdate >= forget_from) {
-      best.kill(i);
-      continue;
+  bool died = false;
+  for (LiveBlock& lb : best.live) {
+    for (std::uint32_t alive = lb.alive; alive != 0; alive &= alive - 1) {
+      const int j = __builtin_ctz(alive);
+      const int i = lb.block * kLandmarkBlock + j;
+      const std::int64_t id = best.slot(i).lm.id;
+      if (id / kIdsPerUpdate >= forget_from) {
+        lb.alive &= ~(1u << j);
+        died = true;
+        continue;
+      }
+      const auto it = std::lower_bound(sorted.begin(), sorted.end(), id,
+                                       [](const auto& a, std::int64_t k) { return a.first < k; });
+      if (it == sorted.end() || it->first != id || !finite(it->second)) continue;
+      best.mutable_slot(i).lm.mean = it->second;
+      lb.bounds.cover(it->second);  // the box grows to the moved mean (a bound, never too small)
     }
-    const auto it = std::lower_bound(sorted.begin(), sorted.end(), s.lm.id,
-                                     [](const auto& a, std::int64_t id) { return a.first < id; });
-    if (it == sorted.end() || it->first != s.lm.id || !finite(it->second)) continue;
-    best.mutable_slot(i).lm.mean = it->second;
   }
+  if (died) best.sweep();
   for (Particle& p : particles_) p = best;
   best_ = 0;
 }

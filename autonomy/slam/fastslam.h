@@ -302,6 +302,9 @@ class FastSlam {
     Pose2 pose;                                 // s^ until the update samples it
     Eigen::Matrix3d P = Eigen::Matrix3d::Zero();  // pose covariance since the last update
     double weight = 1.0;
+    // the parent's index while an unchanged copy from a resample (its
+    // copies are consecutive), -1 once updated
+    int copy_of = -1;
     // by number: shared between particles until written; null once its slots all died
     std::vector<std::shared_ptr<Block>> blocks;
     std::vector<LiveBlock> live;                 // the blocks not null, by number
@@ -333,16 +336,25 @@ class FastSlam {
   };
 
   void prepare(const std::vector<Observation>& obs);  // into frame_
-  void update_particle(Particle& p, const Frame& f, double& log_lik, std::vector<std::int64_t>& ids);
+  // the proposal of FastSLAM 2.0 before its draw: mean, covariance and the
+  // observations' log-likelihood
+  struct Proposal {
+    Pose2 mean;
+    Eigen::Matrix3d cov;
+    double log_lik;
+  };
+
+  void update_particle(Particle& p, const Frame& f, bool copy_of_previous, double& log_lik,
+                       std::vector<std::int64_t>& ids);
   // its parts, in order: the landmarks near the particle (into near_), the
   // association (observation -> position in near_ or -1; near_taken_:
-  // the near landmarks taken), the 2.0 proposal and the pose drawn from it, the
-  // associated landmarks' EKFs, the expectations and removals, the new
-  // tentative landmarks
+  // the near landmarks taken), the 2.0 proposal (the pose is drawn from it
+  // in update_particle), the associated landmarks' EKFs, the expectations
+  // and removals, the new tentative landmarks
   void gather_near(const Particle& p);
   const std::vector<int>& associate(const Particle& p, const Frame& f);
   void find_candidates(const Particle& p, const Frame& f);  // into cands_
-  void propose_and_sample(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
+  void propose(const Particle& p, const Frame& f, const std::vector<int>& match);  // into proposal_
   void update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
   void expect_and_remove(Particle& p);
   void add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik,
@@ -375,6 +387,7 @@ class FastSlam {
   std::vector<int> cands_per_obs_, cands_per_near_;
   std::vector<int> match_;
   std::vector<char> near_taken_;
+  Proposal proposal_;
 };
 
 }  // namespace paddock::slam
