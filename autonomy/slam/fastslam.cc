@@ -115,19 +115,24 @@ double FastSlam::Bounds::squared_distance(Vec2 c) const {
 }
 
 FastSlam::Slot& FastSlam::Particle::mutable_slot(int i) {
-  std::shared_ptr<Block>& b = blocks[i / kLandmarkBlock];
-  if (b.use_count() > 1) b = std::make_shared<Block>(*b);  // copy on write
+  BlockRef& ref = blocks[static_cast<std::size_t>(i / kLandmarkBlock)];
+  std::shared_ptr<Block>& b = live[static_cast<std::size_t>(ref.live)].block;
+  if (b.use_count() > 1) {
+    b = std::make_shared<Block>(*b);  // copy on write
+    ref.block = b.get();
+  }
   return b->slots[i % kLandmarkBlock];
 }
 
 int FastSlam::Particle::add(const Slot& s) {
   const int i = size++;
-  const std::size_t b = static_cast<std::size_t>(i / kLandmarkBlock);
-  if (b == blocks.size()) blocks.emplace_back();
-  if (!blocks[b]) {
+  const int b = i / kLandmarkBlock;
+  if (b == static_cast<int>(blocks.size())) blocks.push_back({nullptr, -1});
+  BlockRef& ref = blocks[static_cast<std::size_t>(b)];
+  if (!ref.block) {
     // a new block, or the last one again after its slots so far all died
-    blocks[b] = std::make_shared<Block>();
-    live.push_back({static_cast<int>(b), 0u, Bounds{}});
+    live.push_back({std::make_shared<Block>(), b, 0u, Bounds{}});
+    ref = {live.back().block.get(), static_cast<int>(live.size()) - 1};
   }
   mutable_slot(i) = s;
   LiveBlock& lb = live.back();  // the last block is the last live one
@@ -139,9 +144,18 @@ int FastSlam::Particle::add(const Slot& s) {
 void FastSlam::Particle::sweep() {
   // nothing reads a dead slot: a block of dead ones need not be kept (or
   // copied by a resample)
-  for (const LiveBlock& lb : live)
-    if (lb.alive == 0) blocks[static_cast<std::size_t>(lb.block)].reset();
-  live.erase(std::remove_if(live.begin(), live.end(), [](const LiveBlock& lb) { return lb.alive == 0; }), live.end());
+  std::size_t n = 0;
+  for (LiveBlock& lb : live) {
+    BlockRef& ref = blocks[static_cast<std::size_t>(lb.number)];
+    if (lb.alive == 0) {
+      ref = {nullptr, -1};
+      continue;
+    }
+    ref.live = static_cast<int>(n);
+    if (&live[n] != &lb) live[n] = std::move(lb);
+    ++n;
+  }
+  live.resize(n);
 }
 
 FastSlam::FastSlam(const FastSlamParams& p, std::uint64_t seed)
@@ -298,7 +312,7 @@ void FastSlam::gather_near(const Particle& p) {
     const LiveBlock& lb = p.live[l];
     if (lb.bounds.squared_distance(p.pose.position()) >= reach * reach) continue;
     in_reach_.push_back(static_cast<int>(l));
-    const Block& block = *p.blocks[static_cast<std::size_t>(lb.block)];
+    const Block& block = *lb.block;
     for (std::uint32_t alive = lb.alive; alive != 0; alive &= alive - 1) {
       const char* slot = reinterpret_cast<const char*>(&block.slots[static_cast<std::size_t>(__builtin_ctz(alive))]);
       __builtin_prefetch(slot);
@@ -308,14 +322,14 @@ void FastSlam::gather_near(const Particle& p) {
   for (int l : in_reach_) {
     const LiveBlock& lb = p.live[static_cast<std::size_t>(l)];
     // its alive slots, lowest first (the order of the indices)
-    const Block& block = *p.blocks[static_cast<std::size_t>(lb.block)];
+    const Block& block = *lb.block;
     for (std::uint32_t alive = lb.alive; alive != 0; alive &= alive - 1) {
       const int j = __builtin_ctz(alive);
       const Slot& s = block.slots[static_cast<std::size_t>(j)];
       const double d2 = squared_norm(s.lm.mean - p.pose.position());
       // (one under the car has no stable bearing: neither scored nor expected)
       if (d2 < reach * reach && d2 > under2) {
-        near_.push_back(lb.block * kLandmarkBlock + j);
+        near_.push_back(lb.number * kLandmarkBlock + j);
         near_live_.push_back(l);
         near_x_.push_back(s.lm.mean.x);
         near_y_.push_back(s.lm.mean.y);
@@ -621,7 +635,7 @@ void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int6
   for (LiveBlock& lb : best.live) {
     for (std::uint32_t alive = lb.alive; alive != 0; alive &= alive - 1) {
       const int j = __builtin_ctz(alive);
-      const int i = lb.block * kLandmarkBlock + j;
+      const int i = lb.number * kLandmarkBlock + j;
       const std::int64_t id = best.slot(i).lm.id;
       if (id / kIdsPerUpdate >= forget_from) {
         lb.alive &= ~(1u << j);
@@ -650,7 +664,7 @@ std::vector<Landmark> FastSlam::landmarks(bool confirmed_only) const {
   std::vector<Landmark> out;
   for (const LiveBlock& lb : p.live) {
     for (std::uint32_t alive = lb.alive; alive != 0; alive &= alive - 1) {
-      const Slot& s = p.slot(lb.block * kLandmarkBlock + __builtin_ctz(alive));
+      const Slot& s = lb.block->slots[static_cast<std::size_t>(__builtin_ctz(alive))];
       if (s.lm.confirmed || !confirmed_only) out.push_back(s.lm);
     }
   }

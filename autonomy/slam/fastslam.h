@@ -285,19 +285,26 @@ class FastSlam {
     // floating point too (each difference rounds monotonically)
     double squared_distance(Vec2 c) const;
   };
-  // a block with an alive slot, as a particle sees it: its number, which
-  // of its slots are alive (bit j: slot j) and the bounds of its means. A
-  // particle's live blocks are a short list beside its block pointers: most
-  // slots die young (a ghost, a far cone seen once), a particle gathers
-  // thousands of them over ten laps, and the search of nearby landmarks
-  // reads neither their blocks nor their slots. A block whose slots have
-  // all died is let go.
+  // a block with an alive slot, as a particle holds it: the pointer (shared
+  // between particles until written), its number, which of its slots are
+  // alive (bit j: slot j) and the bounds of their means. A particle's live
+  // blocks are a short list: most slots die young (a ghost, a far cone seen
+  // once), a particle gathers thousands of them over ten laps, and neither
+  // the search of nearby landmarks nor a resample's copy touches their
+  // blocks. A block whose slots have all died is let go.
   struct LiveBlock {
-    int block;
+    std::shared_ptr<Block> block;
+    int number;
     std::uint32_t alive;
     Bounds bounds;
   };
   static_assert(kLandmarkBlock <= 32, "LiveBlock::alive holds a block's slots");
+  // a block by number, for reading: its live entry's block and position
+  // (null, -1 once its slots all died); plain data, copied as a whole
+  struct BlockRef {
+    Block* block;
+    int live;
+  };
   struct Particle {
     Pose2 pose;                                 // s^ until the update samples it
     Eigen::Matrix3d P = Eigen::Matrix3d::Zero();  // pose covariance since the last update
@@ -305,11 +312,10 @@ class FastSlam {
     // the parent's index while an unchanged copy from a resample (its
     // copies are consecutive), -1 once updated
     int copy_of = -1;
-    // by number: shared between particles until written; null once its slots all died
-    std::vector<std::shared_ptr<Block>> blocks;
-    std::vector<LiveBlock> live;                 // the blocks not null, by number
+    std::vector<LiveBlock> live;                 // by number
+    std::vector<BlockRef> blocks;                // by number
     int size = 0;                                // slots used
-    const Slot& slot(int i) const { return blocks[i / kLandmarkBlock]->slots[i % kLandmarkBlock]; }
+    const Slot& slot(int i) const { return blocks[i / kLandmarkBlock].block->slots[i % kLandmarkBlock]; }
     Slot& mutable_slot(int i);                   // clones a shared block first
     int add(const Slot& s);                      // a new alive slot
     void sweep();                                // lets go of the live blocks with no alive slot left
