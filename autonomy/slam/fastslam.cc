@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include <Eigen/Cholesky>
@@ -82,6 +83,18 @@ GaussTerms gauss_terms(const Vector2d& nu, const Matrix2d& S) {
 }
 
 double log_gauss(const GaussTerms& g) { return -0.5 * g.d2 - kLog2Pi - 0.5 * std::log(g.det); }
+
+// log_gauss(g) >= level, known without its log: det < 2^e for det's binary
+// exponent e, so log N > -d2 / 2 - log(2 pi) - e log(2) / 2; a margin of
+// 1e-6, far above the rounding of either side. False: the log must decide.
+bool surely_above(const GaussTerms& g, double level) {
+  if (!(g.det > 0.0 && g.det <= std::numeric_limits<double>::max() && g.d2 < std::numeric_limits<double>::max())) return false;
+  std::uint64_t bits;
+  std::memcpy(&bits, &g.det, sizeof bits);
+  const int e = static_cast<int>((bits >> 52) & 0x7ff) - 1022;  // det in [2^(e-1), 2^e) (below, if subnormal)
+  constexpr double kLn2 = 0.6931471805599453;
+  return -0.5 * g.d2 - kLog2Pi - 0.5 * kLn2 * static_cast<double>(e) >= level + 1e-6;
+}
 
 // log N(nu; 0, S)
 double log_gauss(const Vector2d& nu, const Matrix2d& S) { return log_gauss(gauss_terms(nu, S)); }
@@ -243,11 +256,6 @@ void FastSlam::prepare(const std::vector<Observation>& obs) {
   });
   f.sorted_x.clear();
   for (int k : f.by_x) f.sorted_x.push_back(f.obs[static_cast<std::size_t>(k)]->position.x);
-  // log N = -d2 / 2 - log(2 pi) - log(det) / 2 >= log(p0) for any d2 within
-  // the gate when det <= this (a margin of 1e-6 in the log, far above its
-  // rounding): the association needs no log to know it
-  const double log_p0 = std::log(params_.new_landmark_likelihood);
-  f.det_sure = std::exp(-2.0 * (log_p0 + kLog2Pi) - params_.association_gate - 1e-6);
 }
 
 void FastSlam::update(const std::vector<Observation>& obs) {
@@ -385,7 +393,7 @@ void FastSlam::find_candidates(const Particle& p, const Frame& f) {
       if (!(mahalanobis2(nu, Z) <= pr.association_gate)) continue;
       const GaussTerms g = gauss_terms(nu, Z);
       Candidate c{0.0, g.d2, g.det, static_cast<int>(k), static_cast<int>(j), false};
-      if (!(g.det > 0.0 && g.det <= f.det_sure && g.d2 <= pr.association_gate)) {
+      if (!surely_above(g, log_p0)) {
         // not sure to be likelier than a new landmark: the log decides
         c.ll = log_gauss(g);
         c.scored = true;

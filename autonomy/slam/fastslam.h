@@ -329,7 +329,6 @@ class FastSlam {
     std::vector<const Observation*> obs;
     std::vector<double> sorted_x;  // the observations' position.x, ascending
     std::vector<int> by_x;         // their indices in that order
-    double det_sure = 0.0;         // an association candidate's det S below which it is surely likelier than p0
   };
   // an association candidate: its log-likelihood (once scored) and its
   // parts, observation, position in near_
