@@ -255,7 +255,11 @@ void FastSlam::prepare(const std::vector<Observation>& obs) {
     return xa < xb || (xa == xb && a < b);
   });
   f.sorted_x.clear();
-  for (int k : f.by_x) f.sorted_x.push_back(f.obs[static_cast<std::size_t>(k)]->position.x);
+  f.sorted_y.clear();
+  for (int k : f.by_x) {
+    f.sorted_x.push_back(f.obs[static_cast<std::size_t>(k)]->position.x);
+    f.sorted_y.push_back(f.obs[static_cast<std::size_t>(k)]->position.y);
+  }
 }
 
 void FastSlam::update(const std::vector<Observation>& obs) {
@@ -362,22 +366,24 @@ void FastSlam::find_candidates(const Particle& p, const Frame& f) {
     land_x_[k] = p.pose.x + cy * o.x - sy * o.y;
     land_y_[k] = p.pose.y + sy * o.x + cy * o.y;
   }
-  // the observations to try, by their x in the base frame: within the
-  // radius of the landmark's x there, and a margin far above the rounding
-  // of the two frames (the distance test itself is the world frame's)
+  // the observations to try, by their position in the base frame: x, then
+  // y within the radius of the landmark's there, and a margin far above the
+  // rounding of the two frames (the distance test itself is the world frame's)
   const double band = pr.search_radius + 1e-9 * (1.0 + pr.search_radius + std::abs(p.pose.x) + std::abs(p.pose.y));
   const double r2 = pr.search_radius * pr.search_radius;
   const Matrix2d assoc = pr.association_std * pr.association_std * Matrix2d::Identity();
   cands_.clear();
   for (std::size_t j = 0; j < near_.size(); ++j) {
-    const double bx = cy * (near_x_[j] - p.pose.x) + sy * (near_y_[j] - p.pose.y);
-    auto it = std::lower_bound(f.sorted_x.begin(), f.sorted_x.end(), bx - band);
+    const double dx = near_x_[j] - p.pose.x, dy = near_y_[j] - p.pose.y;
+    const double bx = cy * dx + sy * dy, by = cy * dy - sy * dx;
+    std::size_t i = static_cast<std::size_t>(std::lower_bound(f.sorted_x.begin(), f.sorted_x.end(), bx - band) - f.sorted_x.begin());
     // h, H_m C H_m^T and H_s P H_s^T: the landmark's, whichever observation
     bool predicted = false;
     Predicted h;
     Matrix2d HCH, HPH;
-    for (; it != f.sorted_x.end() && *it <= bx + band; ++it) {
-      const std::size_t k = static_cast<std::size_t>(f.by_x[static_cast<std::size_t>(it - f.sorted_x.begin())]);
+    for (; i < f.sorted_x.size() && f.sorted_x[i] <= bx + band; ++i) {
+      if (std::abs(f.sorted_y[i] - by) > band) continue;
+      const std::size_t k = static_cast<std::size_t>(f.by_x[i]);
       const double ex = near_x_[j] - land_x_[k], ey = near_y_[j] - land_y_[k];
       if (ex * ex + ey * ey > r2) continue;
       if (!predicted) {

@@ -328,6 +328,7 @@ class FastSlam {
     std::vector<Eigen::Matrix2d> R;
     std::vector<const Observation*> obs;
     std::vector<double> sorted_x;  // the observations' position.x, ascending
+    std::vector<double> sorted_y;  // their position.y
     std::vector<int> by_x;         // their indices in that order
   };
   // an association candidate: its log-likelihood (once scored) and its
