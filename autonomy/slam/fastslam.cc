@@ -6,6 +6,7 @@
 #include <limits>
 
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
@@ -186,6 +187,8 @@ void FastSlam::reset(const Pose2& pose) {
   }
   best_ = 0;
   neff_ = params_.particles;
+  anchor_ = {particles_[0].pose, Matrix3d::Zero(), Matrix3d::Zero()};
+  cov_.setZero();
 }
 
 void FastSlam::predict(const Pose2& delta) {
@@ -302,6 +305,7 @@ void FastSlam::update(const std::vector<Observation>& obs) {
   for (std::size_t k = 0; k < ids.size(); ++k) best_sightings_.emplace_back(ids[k], frame_.obs[k]->position);
   ++updates_;
   if (neff_ < params_.resample_neff_ratio * static_cast<double>(n)) resample();
+  update_covariance();
 }
 
 void FastSlam::gather_near(const Particle& p) {
@@ -699,7 +703,7 @@ Pose2 FastSlam::mean_pose() const {
   return {x, y, wrap_angle(ref + dyaw)};
 }
 
-Matrix3d FastSlam::pose_covariance() const {
+Matrix3d FastSlam::cloud_covariance() const {
   const Pose2 mean = mean_pose();
   Matrix3d c = Matrix3d::Zero();
   for (const Particle& p : particles_) {
@@ -707,6 +711,62 @@ Matrix3d FastSlam::pose_covariance() const {
     c += p.weight * (p.P + e * e.transpose());
   }
   return c;
+}
+
+namespace {
+// a frame error (dx, dy, dyaw) at pose `from` seen at pose `to`: its yaw
+// error moves `to` by the lever arm from `from`
+Matrix3d carry(const Matrix3d& cov, const Pose2& from, const Pose2& to) {
+  Matrix3d J = Matrix3d::Identity();
+  J(0, 2) = -(to.y - from.y);
+  J(1, 2) = to.x - from.x;
+  return J * cov * J.transpose();
+}
+}  // namespace
+
+void FastSlam::update_covariance() {
+  // called at the end of update(): updates_ already counts it
+  const std::int64_t now = updates_ - 1;
+  const Pose2 here = mean_pose();
+  // the older frames the best particle saw a landmark of, each once
+  seen_frames_.clear();
+  for (const auto& sighting : best_sightings_) {
+    const std::int64_t u = sighting.first / kIdsPerUpdate;
+    if (sighting.first >= 0 && u < now && u < static_cast<std::int64_t>(anchors_.size())) seen_frames_.push_back(u);
+  }
+  std::sort(seen_frames_.begin(), seen_frames_.end());
+  seen_frames_.erase(std::unique(seen_frames_.begin(), seen_frames_.end()), seen_frames_.end());
+  // the anchor: the smallest of their frame errors here, else the last one
+  Matrix3d anchor = carry(anchor_.common, anchor_.pose, here);
+  std::int64_t from = -1;
+  for (const std::int64_t u : seen_frames_) {
+    const Anchor& a = anchors_[static_cast<std::size_t>(u)];
+    const Matrix3d c = carry(a.common + a.relative, a.pose, here);
+    if (from < 0 || c.trace() < anchor.trace()) {
+      anchor = c;
+      from = u;
+    }
+  }
+  const Matrix3d cloud = cloud_covariance();
+  cov_ = cloud + anchor;
+  anchor_ = {here, anchor, Matrix3d::Zero()};
+  anchors_.resize(static_cast<std::size_t>(updates_));
+  anchors_[static_cast<std::size_t>(now)] = {here, anchor, cloud};
+  // the other frames seen: their landmarks were seen again from here, at
+  // `cloud` from the anchor's frame: the relative part takes it in as a
+  // Kalman update (sightings from different poses: independent parts), the
+  // common part never grows past the anchor's
+  for (const std::int64_t u : seen_frames_) {
+    if (u == from) continue;  // the anchor itself: its own error, nothing new
+    Anchor& a = anchors_[static_cast<std::size_t>(u)];
+    const Matrix3d common = carry(anchor, here, a.pose);
+    if (common.trace() < a.common.trace()) a.common = common;
+    const Matrix3d rel = carry(cloud, here, a.pose);
+    const Matrix3d gain = a.relative * (a.relative + rel).completeOrthogonalDecomposition().pseudoInverse();
+    const Matrix3d I_G = Matrix3d::Identity() - gain;
+    const Matrix3d r = I_G * a.relative * I_G.transpose() + gain * rel * gain.transpose();
+    a.relative = 0.5 * (r + r.transpose());
+  }
 }
 
 }  // namespace paddock::slam

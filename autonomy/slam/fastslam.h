@@ -242,10 +242,14 @@ class FastSlam {
   std::vector<Landmark> map() const;
   // all its landmarks, tentative ones too
   std::vector<Landmark> all_landmarks() const;
-  // the particle set's weighted mean and covariance (x, y, yaw) (for
-  // consistency checks; yaw averaged about the best particle's)
+  // the particle set's weighted mean (x, y, yaw; yaw averaged about the
+  // best particle's)
   Pose2 mean_pose() const;
-  Eigen::Matrix3d pose_covariance() const;
+  // the estimate's covariance (x, y, yaw) in the world frame after the last
+  // update: the particle set's covariance plus its map's anchor (below)
+  const Eigen::Matrix3d& pose_covariance() const { return cov_; }
+  // the particle set's own weighted covariance about mean_pose()
+  Eigen::Matrix3d cloud_covariance() const;
 
   double effective_particles() const { return neff_; }  // N_eff after the last update
   int resamples() const { return resamples_; }
@@ -378,6 +382,32 @@ class FastSlam {
   std::int64_t updates_ = 0;
   std::vector<std::vector<std::int64_t>> frame_ids_;  // per particle, per observation, this update
   std::vector<std::pair<std::int64_t, Vec2>> best_sightings_;
+  // The map's own error in the world frame. Resampling soon leaves the
+  // particles one ancestor, so they share one map and their spread is the
+  // pose's uncertainty relative to that map only, not to the world (Bailey,
+  // Nieto, Nebot 2006, "Consistency of the FastSLAM algorithm"): alone, it
+  // makes the estimate overconfident over a lap. So each update's new
+  // landmarks inherit a frame error (by the update number in their ids): the
+  // estimate's anchor then (common: shared by all it was carried to) plus
+  // the set's spread then (relative: theirs alone). The estimate's
+  // covariance is the set's spread plus its anchor: the smallest frame error
+  // among the older landmarks the best particle saw, carried to the current
+  // pose (a frame's yaw error moves a point by its lever arm); without one,
+  // the last anchor. A frame seen again from a pose anchored elsewhere takes
+  // the new sighting into its relative part as a Kalman update and keeps the
+  // smaller common part. The first landmarks, made at the start pose, have
+  // none: seeing them again (the loop's end) brings the covariance back to
+  // the set's spread. Reported only: no estimate depends on it.
+  struct Anchor {
+    Pose2 pose;  // where the frame's error is taken
+    Eigen::Matrix3d common = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d relative = Eigen::Matrix3d::Zero();
+  };
+  std::vector<Anchor> anchors_;  // by update number
+  Anchor anchor_;                // the estimate's, at the last update (relative 0)
+  Eigen::Matrix3d cov_ = Eigen::Matrix3d::Zero();
+  std::vector<std::int64_t> seen_frames_;  // scratch of update_covariance
+  void update_covariance();
   // scratch of resample: the parent of each new particle, the new set
   std::vector<int> picks_;
   std::vector<Particle> spare_;

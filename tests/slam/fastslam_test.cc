@@ -114,6 +114,8 @@ double map_rmse(const std::vector<Landmark>& map, const std::vector<TrueCone>& w
 struct RunStats {
   int steps = 0;
   int nees_within = 0;  // steps with NEES <= chi2(3 dof, 95 %)
+  int open_steps = 0;   // steps before the start's cones come back into view
+  double open_nees_sum = 0.0;
   double pose_err_sum = 0.0;
   double pose_err_max = 0.0;
   double map_rmse = 0.0;
@@ -139,6 +141,10 @@ RunStats drive(FastSlam& slam, const std::vector<TrueCone>& world, const Noise& 
     const double nees = e.dot(C.inverse() * e);
     ++st.steps;
     if (nees <= kChi2_3dof_95) ++st.nees_within;
+    if (k * kStep < 2.0 * kPi * kRadius - kSensorRange - 2.0) {
+      ++st.open_steps;
+      st.open_nees_sum += nees;
+    }
     const double pe = pose_error(slam.pose(), truth);
     st.pose_err_sum += pe;
     st.pose_err_max = std::max(st.pose_err_max, pe);
@@ -218,29 +224,37 @@ TEST(FastSlam, ExactInputsGiveAnExactPoseAndMap) {
 TEST(FastSlam, NoisyLoopIsConsistentAndMapsAccurately) {
   const auto world = ring_world();
   const Noise n = realistic();
-  int steps = 0, within = 0;
-  double worst_rmse = 0.0, sum_rmse = 0.0;
+  int steps = 0, within = 0, open_steps = 0;
+  double worst_rmse = 0.0, sum_rmse = 0.0, open_nees = 0.0;
   constexpr int kSeeds = 20;
   for (int seed = 1; seed <= kSeeds; ++seed) {
     FastSlam slam(params_for(n, 2, FastSlamParams{}.particles), 100 + seed);
     const RunStats st = drive(slam, world, n, static_cast<std::uint64_t>(seed), kLoop);
     steps += st.steps;
     within += st.nees_within;
+    open_steps += st.open_steps;
+    open_nees += st.open_nees_sum;
     worst_rmse = std::max(worst_rmse, st.map_rmse);
     sum_rmse += st.map_rmse;
     // every cone mapped once: the loop closed without duplicates
     EXPECT_EQ(st.map_size, world.size()) << "seed " << seed;
   }
   const double share = static_cast<double>(within) / steps;
-  std::printf("FastSLAM 2.0, %d seeds: NEES within the 95 %% bound on %.1f %% of steps; map RMSE mean %.4f m, worst %.4f m\n",
-              kSeeds, 100.0 * share, sum_rmse / kSeeds, worst_rmse);
-  // NOT the 90 % target: FastSLAM's particle cloud loses its spread of map
-  // histories to resampling (Bailey, Nieto, Nebot 2006, "Consistency of the
-  // FastSLAM algorithm") and grows overconfident over a loop (each step on
-  // its own is consistent: mean NEES 3.1-3.2 over 200 seeds with 1000
-  // particles). Measured with the default 200 particles: 72.8 % (100: 64 %,
-  // 300: 81 %, 1000: ~86 %); this guards it against regressions
-  EXPECT_GE(share, 0.70);
+  const double mean_open = open_nees / open_steps;
+  std::printf("FastSLAM 2.0, %d seeds: NEES within the 95 %% bound on %.1f %% of steps, mean NEES %.2f before the "
+              "loop's end; map RMSE mean %.4f m, worst %.4f m\n",
+              kSeeds, 100.0 * share, mean_open, sum_rmse / kSeeds, worst_rmse);
+  // the covariance is the particles' spread plus the map's anchor (see
+  // fastslam.h): measured 92.5 % (the spread alone: 72.8 %, its map's drift
+  // over the lap unaccounted). The misses are mostly the loop's last ten
+  // steps: the start's cones seen again pull the map and the pose part way
+  // (FastSLAM alone; the pose graph is what closes the loop)
+  EXPECT_GE(share, 0.90);
+  // and not by a bound too wide: a consistent filter's mean NEES is 3 (its
+  // 3 dof); measured 2.7 (the spread alone: ~5; a frame error that adds the
+  // whole spread at every new landmark: ~1)
+  EXPECT_GT(mean_open, 1.8);
+  EXPECT_LT(mean_open, 4.2);
   // the 0.1 m target is met on average, not by every seed: measured mean
   // 0.13 m, worst 0.27 m (1 % range noise is 12 cm at 10 m, ~4 cones in view)
   EXPECT_LT(sum_rmse / kSeeds, 0.15);
