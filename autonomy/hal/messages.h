@@ -52,13 +52,20 @@ struct ConeDetections {
   std::vector<DetectedCone> cones;
 };
 
-// the inertial measurement unit: planar specific force and yaw rate in the
-// base frame's orientation, at the IMU's mounting point
+// the inertial measurement unit, six axes: specific force (what an
+// accelerometer measures: acceleration minus gravity, so a level car at rest
+// reads az = +g) and angular rate, in the base frame's orientation (x
+// forward, y left, z up), at the IMU's mounting point. The planar fields come
+// first: the velocity estimator and the perception's odometry read ax, ay
+// and yaw_rate only.
 struct Imu {
   TimeNs stamp = 0;
-  double ax = 0.0;        // m/s^2, forward
-  double ay = 0.0;        // m/s^2, left
-  double yaw_rate = 0.0;  // rad/s
+  double ax = 0.0;          // m/s^2, forward
+  double ay = 0.0;          // m/s^2, left
+  double yaw_rate = 0.0;    // rad/s, about z (> 0 turning left)
+  double az = 0.0;          // m/s^2, up
+  double roll_rate = 0.0;   // rad/s, about x
+  double pitch_rate = 0.0;  // rad/s, about y
 };
 
 // the four wheels' angular speeds: front left, front right, rear left, rear right

@@ -20,16 +20,39 @@ void measure_cones(SimState& s, const Pose2& base) {
   while (s.visible.size() > 4) s.visible.pop_front();
 }
 
+// the vertical acceleration of the IMU's mounting point as it keeps its
+// height above the ground under it: z = h(p(t)), so z'' = grad h . a + v^T H v
+// with the point's horizontal velocity v and acceleration a (world frame);
+// a_base: the base origin's acceleration in the base frame
+double imu_vertical_accel(const SimModel& model, const SimState& s, const Pose2& base, double ax_base,
+                          double ay_base) {
+  if (sensors::flat(model.scenario.ground)) return 0.0;
+  const sensors::ImuParams& imu = s.imu.params();
+  const double rx = imu.mount_x, ry = imu.mount_y, w = s.car.r, dw = s.car.yaw_accel;
+  const Vec2 vb = vehicle::base_velocity(model.scenario.vehicle, s.car);
+  // the point's velocity and acceleration in the base frame (rigid body)
+  const Vec2 v{vb.x - w * ry, vb.y + w * rx};
+  const Vec2 a{ax_base - dw * ry - w * w * rx, ay_base + dw * rx - w * w * ry};
+  const double c = std::cos(base.yaw), sn = std::sin(base.yaw);
+  const Vec2 vw{c * v.x - sn * v.y, sn * v.x + c * v.y};
+  const Vec2 aw{c * a.x - sn * a.y, sn * a.x + c * a.y};
+  const Vec2 p = base.transform({rx, ry});
+  const sensors::GroundShape g = sensors::ground_shape(model.scenario.ground, p.x, p.y);
+  return g.dx * aw.x + g.dy * aw.y + g.dxx * vw.x * vw.x + 2.0 * g.dxy * vw.x * vw.y + g.dyy * vw.y * vw.y;
+}
+
 // the odometry sensors due now: the IMU at the base origin's acceleration
 // (from the CG's: a_base = a_cg + alpha x r - omega^2 r with r = (-lr, 0)),
 // the wheel speeds, the steering angle
-void measure_odometry(const SimModel& model, SimState& s) {
+void measure_odometry(const SimModel& model, SimState& s, const Pose2& base) {
   const vehicle::VehicleParams& car = model.scenario.vehicle;
   if (s.k % model.every.imu == 0) {
     const double ax_base = s.car.ax + s.car.r * s.car.r * car.lr;
     const double ay_base = s.car.ay - s.car.yaw_accel * car.lr;
-    const sensors::ImuSample m = s.imu.measure(ax_base, ay_base, s.car.r, s.car.yaw_accel, s.now);
-    s.hal.post(hal::Imu{m.stamp, m.ax, m.ay, m.gz});
+    const double az = imu_vertical_accel(model, s, base, ax_base, ay_base);
+    const sensors::ImuSample m = s.imu.measure(ax_base, ay_base, s.car.r, s.car.yaw_accel, s.now, az);
+    s.last_imu = hal::Imu{m.stamp, m.ax, m.ay, m.gz, m.az, m.gx, m.gy};
+    s.hal.post(s.last_imu);
   }
   if (s.k % model.every.wheel_speeds == 0) {
     const sensors::WheelSpeedSample m = s.wheel_speeds.measure(vehicle::wheel_speeds(car, s.car), s.now);
@@ -96,7 +119,7 @@ void run_due(const SimModel& model, SimState& s) {
     s.visible.emplace_back(s.raw->scan_end(s.now), cones_hit(hit, static_cast<std::size_t>(s.cones.cone_count())));
     while (s.visible.size() > 4) s.visible.pop_front();
   }
-  measure_odometry(model, s);
+  measure_odometry(model, s, base);
   s.controlled = s.k % model.every.control == 0;
   if (s.controlled) control(model, s, base);
   s.sampled = s.k % model.every.log == 0;

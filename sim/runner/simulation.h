@@ -70,6 +70,7 @@ struct SimState {
   // perception = lidar | lidar_camera: the LiDAR and the camera it triggers
   std::unique_ptr<RawSensors> raw;
   sensors::Imu imu;
+  hal::Imu last_imu;  // the IMU's last sample, as posted
   sensors::WheelSpeedSensor wheel_speeds;
   sensors::SteeringSensor steering;
 

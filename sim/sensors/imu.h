@@ -1,10 +1,18 @@
 #pragma once
-// a planar strapdown IMU: a two-axis accelerometer (x forward, y left) and a
-// yaw-rate gyro, with white noise per sample, a turn-on bias and a bias that
-// performs a random walk (the two error terms of a MEMS data sheet and of a
-// Kalibr-style IMU noise model). The sensor axes are the base frame's; the
-// sensor sits at (mount_x, mount_y) in the base frame, and measure() adds the
-// rigid-body lever-arm term from the base origin to that point.
+// a six-axis strapdown IMU: a three-axis accelerometer (specific force: a
+// level sensor at rest reads az = +g) and a three-axis gyro, with white noise
+// per sample, a turn-on bias and a bias that performs a random walk (the two
+// error terms of a MEMS data sheet and of a Kalibr-style IMU noise model). The
+// sensor axes are the base frame's; the sensor sits at (mount_x, mount_y) in
+// the base frame, and measure() adds the rigid-body lever-arm term from the
+// base origin to that point. The car's body stays level (the vehicle model is
+// planar; see lidar.h's ground): the roll and pitch rates are 0 and the
+// vertical axis feels gravity plus the vertical acceleration of the mounting
+// point as it keeps its height above the ground under it.
+//
+// The planar axes (ax, ay, gz) draw from the sensor's stream as they always
+// did; the out-of-plane axes (az, gx, gy) from a second stream of their own,
+// so a scenario's planar samples do not change with them.
 //
 // Model (ImuParams) + a small class holding its random stream, its current
 // biases and the previous stamp (Imu). No I/O, no clock, no global state.
@@ -79,6 +87,9 @@ struct ImuSample {
   double ax = 0.0;  // m/s^2, specific force along x (forward)
   double ay = 0.0;  // m/s^2, specific force along y (left)
   double gz = 0.0;  // rad/s, yaw rate (> 0 turning left)
+  double az = 0.0;  // m/s^2, specific force along z (up)
+  double gx = 0.0;  // rad/s, roll rate
+  double gy = 0.0;  // rad/s, pitch rate
 };
 
 // the current biases, for tests and for the run's ground-truth log
@@ -86,6 +97,9 @@ struct ImuBias {
   double ax = 0.0;  // m/s^2
   double ay = 0.0;  // m/s^2
   double gz = 0.0;  // rad/s
+  double az = 0.0;  // m/s^2
+  double gx = 0.0;  // rad/s
+  double gy = 0.0;  // rad/s
 };
 
 class Imu {
@@ -102,9 +116,12 @@ class Imu {
   // a_mount = a_base + alpha x r - omega^2 r, then its biases and noise.
   // The biases first take one random-walk step over dt = stamp - previous
   // stamp (none on the first sample; a stamp going backwards counts as dt = 0).
-  // Six normal draws per call whatever the inputs. A NaN input gives a NaN in
-  // the outputs that depend on it and leaves the biases untouched.
-  ImuSample measure(double true_ax, double true_ay, double true_yaw_rate, double true_yaw_accel, TimeNs stamp);
+  // true_az: the vertical acceleration of the MOUNTING POINT (m/s^2, up;
+  // gravity is added here). Six normal draws per call from each stream
+  // whatever the inputs. A NaN input gives a NaN in the outputs that depend
+  // on it and leaves the biases untouched.
+  ImuSample measure(double true_ax, double true_ay, double true_yaw_rate, double true_yaw_accel, TimeNs stamp,
+                    double true_az = 0.0);
 
   const ImuParams& params() const { return params_; }
   const ImuBias& bias() const { return bias_; }
@@ -117,6 +134,8 @@ class Imu {
   ImuParams params_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
+  std::mt19937_64 rng_3d_;  // the out-of-plane axes'
+  std::normal_distribution<double> normal_3d_{0.0, 1.0};
   ImuBias bias_;
   bool has_previous_ = false;
   TimeNs previous_stamp_ = 0;

@@ -81,6 +81,22 @@ double ground_height(const GroundParams& g, double x, double y) {
   return z;
 }
 
+GroundShape ground_shape(const GroundParams& g, double x, double y) {
+  GroundShape d{g.slope_x, g.slope_y, 0.0, 0.0, 0.0};
+  if (g.bump_height != 0.0) {
+    // A sin(kx) sin(ky)
+    const double k = 2.0 * kPi / g.bump_wavelength;
+    const double sx = std::sin(k * x), cx = std::cos(k * x), sy = std::sin(k * y), cy = std::cos(k * y);
+    const double a = g.bump_height;
+    d.dx += a * k * cx * sy;
+    d.dy += a * k * sx * cy;
+    d.dxx = -a * k * k * sx * sy;
+    d.dyy = d.dxx;
+    d.dxy = a * k * k * cx * cy;
+  }
+  return d;
+}
+
 // ---------------------------------------------------------------- LidarWorld
 
 LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked,

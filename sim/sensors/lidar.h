@@ -134,6 +134,15 @@ bool flat(const GroundParams& g);
 // L = bump_wavelength
 double ground_height(const GroundParams& g, double x, double y);
 
+// ground_height's first and second derivatives at (x, y), exact: what a point
+// keeping its height above the ground feels vertically (z'' = grad . a +
+// v^T H v for a horizontal velocity v and acceleration a)
+struct GroundShape {
+  double dx = 0.0, dy = 0.0;              // gradient
+  double dxx = 0.0, dxy = 0.0, dyy = 0.0;  // Hessian
+};
+GroundShape ground_shape(const GroundParams& g, double x, double y);
+
 // the real FS cone sizes (ORACLES.md): a cone mesh is a truncated cone of
 // kConeSegments facets standing on its base, vertices on the true circles
 inline constexpr double kSmallConeBaseWidth = 0.228;  // m

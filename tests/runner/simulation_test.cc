@@ -12,6 +12,7 @@
 #include "sim/runner/model.h"
 #include "sim/runner/sim_hal.h"
 #include "sim/runner/simulation.h"
+#include "sim/sensors/lidar.h"
 
 namespace paddock::runner {
 namespace {
@@ -296,6 +297,49 @@ TEST(Simulation, AKidnappedCarRelocalisesAndDrivesOn) {
   EXPECT_EQ(k.fallbacks, 0);
   EXPECT_EQ(k.oc, 0);
   EXPECT_FALSE(k.dnf);
+}
+
+TEST(Simulation, OnBumpyGroundTheImuFeelsTheClimbOfItsMountingPoint) {
+  // a noise-free IMU on a sloped, bumpy ground: az - g against the second
+  // difference of the true height of its mounting point over the samples
+  // (the truth from the car's state, not from the sensor's formula)
+  const Scenario sc = load_scenario(kRoot + "/scenarios/fsg_2023_trackdrive.ini",
+                                    {"event.timeout=8", "autonomy.perception=ground_truth", "autonomy.slam=ground_truth",
+                                     "ground.slope_x=0.02", "ground.bump_height=0.05", "ground.bump_wavelength=8",
+                                     "imu.accel_noise=0", "imu.gyro_noise=0", "imu.accel_bias_walk=0",
+                                     "imu.gyro_bias_walk=0", "imu.accel_bias_initial_std=0",
+                                     "imu.gyro_bias_initial_std=0"});
+  const SimModel model = compile_model(sc, default_setup().track);
+  const sensors::ImuParams& imu = model.scenario.imu;
+  SimState state(model);
+  std::vector<double> z, az;  // at each IMU sample
+  TimeNs last = -1;
+  double peak = 0.0, worst = 0.0;
+  while (!state.done) {
+    if (state.last_imu.stamp != last) {
+      last = state.last_imu.stamp;
+      const Pose2 base = vehicle::base_pose(model.scenario.vehicle, state.car);
+      const Vec2 p = base.transform({imu.mount_x, imu.mount_y});
+      z.push_back(sensors::ground_height(model.scenario.ground, p.x, p.y));
+      az.push_back(state.last_imu.az);
+      EXPECT_EQ(state.last_imu.roll_rate, 0.0);
+      EXPECT_EQ(state.last_imu.pitch_rate, 0.0);
+      const std::size_t n = z.size();
+      if (n >= 3) {
+        const double h = to_seconds(state.imu.period_ns());
+        const double fd = (z[n - 1] - 2.0 * z[n - 2] + z[n - 3]) / (h * h);
+        const double measured = az[n - 2] - kGravity;
+        peak = std::max(peak, std::abs(fd));
+        worst = std::max(worst, std::abs(fd - measured));
+      }
+    }
+    step(model, state);
+  }
+  std::printf("IMU vertical: |z''| up to %.2f m/s^2, off the second difference by at most %.3f m/s^2 over %zu samples\n",
+              peak, worst, z.size());
+  ASSERT_GT(z.size(), 500u);
+  EXPECT_GT(peak, 1.0);   // the bumps were felt
+  EXPECT_LT(worst, 0.05 * peak);
 }
 
 TEST(Simulation, StreamSeedsDifferPerStream) {

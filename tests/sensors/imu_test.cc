@@ -98,6 +98,72 @@ TEST(Imu, NoiseStdMatchesOver20000Samples) {
   EXPECT_NEAR(sg.mean, 0.3, 5.0 * p.gyro_noise / std::sqrt(20000.0));
 }
 
+TEST(Imu, TheOutOfPlaneAxesReadGravityPlusTheClimbWithTheirOwnNoiseAndBias) {
+  ImuParams p = perfect();
+  p.accel_noise = 0.03;
+  p.gyro_noise = 0.004;
+  Imu imu(p, 42);
+  std::vector<double> az, gx, gy;
+  const TimeNs dt = imu.period_ns();
+  for (int k = 0; k < 20000; ++k) {
+    const ImuSample s = imu.measure(1.5, -0.5, 0.3, 0.0, k * dt, -0.7);  // climbing less and less
+    az.push_back(s.az);
+    gx.push_back(s.gx);
+    gy.push_back(s.gy);
+  }
+  const Stats sz = stats(az), sx = stats(gx), sy = stats(gy);
+  EXPECT_NEAR(sz.stddev, p.accel_noise, 0.05 * p.accel_noise);
+  EXPECT_NEAR(sx.stddev, p.gyro_noise, 0.05 * p.gyro_noise);
+  EXPECT_NEAR(sy.stddev, p.gyro_noise, 0.05 * p.gyro_noise);
+  // specific force: +g at rest, less when the point accelerates downwards
+  EXPECT_NEAR(sz.mean, 9.81 - 0.7, 5.0 * p.accel_noise / std::sqrt(20000.0));
+  // the car stays level: no roll or pitch rate
+  EXPECT_NEAR(sx.mean, 0.0, 5.0 * p.gyro_noise / std::sqrt(20000.0));
+  EXPECT_NEAR(sy.mean, 0.0, 5.0 * p.gyro_noise / std::sqrt(20000.0));
+  // the out-of-plane noise is its own: not correlated with the planar axes'
+  double c = 0.0;
+  Imu again(p, 42);
+  for (int k = 0; k < 20000; ++k) {
+    const ImuSample s = again.measure(0.0, 0.0, 0.0, 0.0, k * dt);
+    c += s.ax * (s.az - 9.81);
+  }
+  EXPECT_LT(std::abs(c / 20000.0) / (p.accel_noise * p.accel_noise), 0.05);
+}
+
+TEST(Imu, TheVerticalInputMovesTheVerticalAxisOnly) {
+  // the planar axes draw from their own stream: a different vertical input
+  // changes nothing in ax, ay, gz
+  const ImuParams p;  // noise, walks, turn-on biases on
+  Imu a(p, 7), b(p, 7);
+  for (int k = 0; k < 1000; ++k) {
+    const ImuSample sa = a.measure(0.4, 1.1, 0.2, 0.05, k * a.period_ns(), 0.0);
+    const ImuSample sb = b.measure(0.4, 1.1, 0.2, 0.05, k * b.period_ns(), 3.0);
+    ASSERT_EQ(sa.ax, sb.ax);
+    ASSERT_EQ(sa.ay, sb.ay);
+    ASSERT_EQ(sa.gz, sb.gz);
+    ASSERT_NE(sa.az, sb.az);
+  }
+  EXPECT_NE(a.bias().az, 0.0);
+  EXPECT_NE(a.bias().gx, a.bias().gy);
+}
+
+TEST(Imu, OutOfPlaneBiasRandomWalkVarianceGrowsAsWalkSquaredTimesT) {
+  ImuParams p = perfect();
+  p.accel_bias_walk = 0.05;
+  p.gyro_bias_walk = 0.01;
+  std::vector<double> az, gx;
+  const TimeNs dt = from_seconds(0.005);
+  for (int seed = 0; seed < 4000; ++seed) {
+    Imu imu(p, static_cast<std::uint64_t>(seed) * 7919u + 1u);
+    ImuSample s;
+    for (TimeNs t = 0; t <= from_seconds(4.0); t += dt) s = imu.measure(0.0, 0.0, 0.0, 0.0, t);
+    az.push_back(s.az - 9.81);
+    gx.push_back(s.gx);
+  }
+  EXPECT_NEAR(stats(az).stddev * stats(az).stddev, 0.05 * 0.05 * 4.0, 0.10 * 0.05 * 0.05 * 4.0);
+  EXPECT_NEAR(stats(gx).stddev * stats(gx).stddev, 0.01 * 0.01 * 4.0, 0.10 * 0.01 * 0.01 * 4.0);
+}
+
 // the variance over seeds of the bias (read through the noise-free output)
 // at the times in `at`, for samples every `period` seconds
 std::vector<double> bias_variance(const ImuParams& p, double period, const std::vector<double>& at, int seeds,
