@@ -1,0 +1,190 @@
+#pragma once
+// the LiDAR-inertial odometry's incremental map: a hashed voxel map (the iVox
+// of Faster-LIO, Bai et al., RA-L 2022), our own code.
+//
+// Design. Space is cut into cubic voxels of voxel_size; a hash table maps a
+// voxel's integer coordinates to a slot of a pool, and a slot holds the
+// voxel's points (float x, y, z) in a small array. Each voxel is cut further
+// into leaves of leaf_size (voxel_size is a whole multiple of it), and a leaf
+// holds at most one map point: FAST-LIO2's down-sampling, where a point is
+// inserted only when its leaf is empty or holds a point farther from the
+// leaf's centre (the new one then replaces it), so the map keeps, in each
+// leaf, the inserted point nearest its centre.
+//
+// A query looks at the query's voxel and its neighbours (nearby: the 6 face
+// neighbours, 18 with the edges, or all 26), nearest boxes first, skips a
+// neighbour whose box lies farther than max_distance or than the k-th best
+// so far, and returns the k nearest points within max_distance sorted by
+// distance. It is exact within the searched voxels; with nearby26 every
+// point within voxel_size of the query is searched, so the answer is the
+// true k nearest whenever max_distance <= voxel_size.
+//
+// Removal: remove_outside drops the points farther than a radius from a
+// centre (whole voxels when their box is out, point by point where a voxel
+// straddles the sphere). A cap on voxels evicts the least recently
+// inserted-into voxel first (a list threaded through the pool, Faster-LIO's
+// LRU).
+//
+// Determinism: no result depends on the hash table's iteration order. The
+// table is only ever asked for one key; removal walks the pool in slot
+// order; eviction follows the LRU list; knn orders candidates by (distance,
+// x, y, z), a total order (no two map points share a leaf), so it returns the
+// same points in the same order whatever order the voxels are visited in.
+//
+// Why a hashed voxel map and not FAST-LIO2's ikd-tree or nanoflann's dynamic
+// index: insertion
+// with down-sampling is a hash look-up and a scan of one small array per
+// point (the ikd-tree or a KD-tree needs a neighbour search per point to
+// down-sample, and a KD-tree must be rebuilt or re-balanced as points come
+// and go; nanoflann's dynamic index only marks removed points, which it keeps
+// searching through until the log-structured trees are merged); removal of
+// what falls out of reach is a walk over the voxels, not a tree
+// re-balancing; a query costs a bounded number of hash look-ups whatever the
+// map's size. The costs: a query is exact only within the searched voxels
+// (a neighbour more than one voxel away is never found); memory per voxel
+// (its key, list links, an array with its own allocation); and the down-
+// sampling keeps at most one point per leaf cell, like FAST-LIO2's.
+//
+// Points are stored as float (as FAST-LIO2's and Faster-LIO's PCL points): a
+// float's step at 1 km is 61 um, far below the leaf and the LiDAR's noise,
+// and halves the memory a query walks. Inserted points are rounded to float
+// first; every decision (leaf, centre distance, knn distance, removal) is
+// then taken on the rounded point, in double.
+//
+// Bad input: a non-finite point, or one too far out for the integer voxel
+// coordinates (|x| / leaf_size >= 2^30), is ignored and counted; knn with
+// k <= 0, a NaN or negative max_distance, a non-finite query or an empty map
+// returns no neighbour. Not thread-safe for writes; const members may run
+// concurrently.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "autonomy/common/params.h"
+
+namespace paddock::slam {
+
+struct VoxelMapParams {
+  enum Nearby { Nearby6, Nearby18, Nearby26 };
+  static constexpr params::Choice<Nearby> kNearbyNames[] = {
+      {"nearby6", Nearby6}, {"nearby18", Nearby18}, {"nearby26", Nearby26}};
+
+  // Faster-LIO's default resolution: a few leaves a side, and a query's
+  // 27 voxels span 1.5 m
+  double voxel_size = 0.5;
+  // FAST-LIO2's map resolution for a spinning LiDAR at close range; a
+  // 32-ring scan keeps ~2/3 of its points (bench/voxel_map_bench.cc)
+  double leaf_size = 0.1;
+  // a plane through a voxel of 5 x 5 x 5 leaves crosses at most 57 of them
+  // (2 million random planes); the cap only bounds a query's work in clutter
+  int max_points_per_voxel = 64;
+  // which neighbours of the query's voxel are searched (the voxel itself
+  // always is)
+  Nearby nearby = Nearby26;
+  // points farther than this from the centre given to remove_outside go: the
+  // LiDAR's 50 m range plus a margin
+  double reach = 60.0;
+  // the least recently inserted-into voxels go beyond this many
+  int max_voxels = 1000000;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(voxel_size), {"m", params::in(0.01, 100.0), "edge of a voxel (a whole multiple of leaf_size)"});
+    v(PADDOCK_PARAM(leaf_size), {"m", params::in(0.001, 100.0), "edge of a down-sampling leaf: at most one map point per leaf"});
+    v(PADDOCK_PARAM(max_points_per_voxel), {"", params::in(1, 1000000), "a voxel holding this many points takes no more"});
+    v(PADDOCK_PARAM(nearby), kNearbyNames, "the voxels a query searches: the query's and its 6 face, 18 face and edge, or all 26 neighbours");
+    v(PADDOCK_PARAM(reach), {"m", params::above(0.0), "remove_outside keeps the points within this distance of its centre"});
+    v(PADDOCK_PARAM(max_voxels), {"", params::in(1, 100000000), "beyond this many voxels the least recently inserted-into one is removed"});
+  }
+  std::string check() const;
+};
+
+class VoxelMap {
+ public:
+  // a map point and its squared distance to the query (m, m^2)
+  struct Neighbour {
+    Eigen::Vector3d point;
+    double distance2 = 0.0;
+  };
+  // what one insert() did with its points
+  struct InsertResult {
+    int added = 0;     // into an empty leaf
+    int replaced = 0;  // nearer its leaf's centre than the point there, which it replaced
+    int skipped = 0;   // its leaf holds a point at least as near the centre
+    int full = 0;      // its voxel already holds max_points_per_voxel points
+    int rejected = 0;  // non-finite or too far out
+    int evicted_voxels = 0;  // voxels removed by the max_voxels cap
+  };
+
+  // throws std::invalid_argument on invalid params
+  explicit VoxelMap(const VoxelMapParams& p = {});
+
+  // world-frame points, in order, with the down-sampling above
+  InsertResult insert(const std::vector<Eigen::Vector3d>& points);
+  // the k nearest map points within max_distance (m) of query, nearest
+  // first, into out (cleared first; allocates only when its capacity is
+  // below k); returns their number
+  int knn(const Eigen::Vector3d& query, int k, double max_distance, std::vector<Neighbour>& out) const;
+  // removes the points farther than reach (m) from centre; returns their
+  // number (none for a non-finite centre or a NaN or negative reach)
+  std::size_t remove_outside(const Eigen::Vector3d& centre, double reach);
+  // with the params' reach
+  std::size_t remove_outside(const Eigen::Vector3d& centre) { return remove_outside(centre, params_.reach); }
+
+  std::size_t size() const { return points_; }   // map points
+  std::size_t voxels() const { return index_.size(); }
+  std::size_t rejected() const { return rejected_; }  // points ignored by insert() so far
+  // every map point (voxels in slot order, each voxel's points in slot order)
+  std::vector<Eigen::Vector3d> points() const;
+  const VoxelMapParams& params() const { return params_; }
+  // empty, as constructed
+  void clear();
+
+ private:
+  struct Key {
+    std::int32_t x, y, z;
+    bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const;
+  };
+  struct Slot {
+    float x, y, z;
+    std::uint32_t leaf;  // the leaf's number inside its voxel
+  };
+  struct Voxel {
+    Key key{};
+    std::uint32_t prev = kNone, next = kNone;  // the LRU list, most recent first
+    bool live = false;
+    std::vector<Slot> points;
+  };
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+
+  // the leaf and voxel of a (float-rounded) point; false when out of range
+  bool locate(const double p[3], std::int64_t leaf[3], Key& voxel) const;
+  std::uint32_t add_voxel(const Key& key);
+  void drop_voxel(std::uint32_t v);
+  void unlink(std::uint32_t v);
+  void push_front(std::uint32_t v);
+
+  VoxelMapParams params_;
+  std::int64_t leaves_per_voxel_ = 1;  // voxel_size / leaf_size
+  double voxel_ = 0.0;                 // leaves_per_voxel_ * leaf_size
+  double max_coord_ = 0.0;             // |x| below this: leaf numbers fit 31 bits
+  std::array<Key, 27> offsets_{};      // the query's voxel, faces, edges, corners
+  int searched_ = 27;                  // how many of offsets_ a query visits
+
+  std::unordered_map<Key, std::uint32_t, KeyHash> index_;
+  std::vector<Voxel> pool_;
+  std::vector<std::uint32_t> free_;
+  std::uint32_t head_ = kNone, tail_ = kNone;
+  std::size_t points_ = 0;
+  std::size_t rejected_ = 0;
+};
+
+}  // namespace paddock::slam
