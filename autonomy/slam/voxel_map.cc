@@ -37,13 +37,65 @@ std::string VoxelMapParams::check() const {
   return "";
 }
 
-std::size_t VoxelMap::KeyHash::operator()(const Key& k) const {
-  // each coordinate times an odd 64-bit constant, folded (Teschner et al.
-  // 2003's spatial hash with wider multipliers)
-  const std::uint64_t h = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.x)) * 0x9E3779B97F4A7C15ull ^
-                          static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.y)) * 0xC2B2AE3D27D4EB4Full ^
-                          static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.z)) * 0x165667B19E3779F9ull;
-  return static_cast<std::size_t>(h ^ (h >> 29));
+std::size_t VoxelMap::Table::home(const Key& k) const {
+  // each coordinate times an odd 64-bit constant, summed, then
+  // murmur3's 64-bit finaliser spreads every bit over the low ones
+  std::uint64_t h = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.x)) * 0x9E3779B97F4A7C15ull +
+                    static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.y)) * 0xC2B2AE3D27D4EB4Full +
+                    static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.z)) * 0x165667B19E3779F9ull;
+  h ^= h >> 33;
+  h *= 0xFF51AFD7ED558CCDull;
+  h ^= h >> 33;
+  return static_cast<std::size_t>(h) & mask_;
+}
+
+std::uint32_t VoxelMap::Table::find(const Key& k) const {
+  if (slots_.empty()) return kNone;
+  for (std::size_t i = home(k);; i = (i + 1) & mask_) {
+    const Entry& e = slots_[i];
+    if (e.v == kNone || e.key == k) return e.v;
+  }
+}
+
+void VoxelMap::Table::insert(const Key& k, std::uint32_t v) {
+  if (2 * (size_ + 1) > slots_.size()) grow();
+  std::size_t i = home(k);
+  while (slots_[i].v != kNone) i = (i + 1) & mask_;
+  slots_[i] = {k, v};
+  ++size_;
+}
+
+void VoxelMap::Table::erase(const Key& k) {
+  std::size_t i = home(k);
+  // present: met before any empty entry
+  while (slots_[i].v == kNone || !(slots_[i].key == k)) i = (i + 1) & mask_;
+  // backward shift: each later entry of the run moves into the hole unless
+  // its home lies cyclically in (hole, entry]
+  for (std::size_t j = (i + 1) & mask_; slots_[j].v != kNone; j = (j + 1) & mask_) {
+    const std::size_t h = home(slots_[j].key);
+    const bool stays = i <= j ? (i < h && h <= j) : (i < h || h <= j);
+    if (stays) continue;
+    slots_[i] = slots_[j];
+    i = j;
+  }
+  slots_[i].v = kNone;
+  --size_;
+}
+
+void VoxelMap::Table::grow() {
+  std::vector<Entry> old;
+  old.swap(slots_);
+  slots_.assign(std::max<std::size_t>(64, 2 * old.size()), Entry{});
+  mask_ = slots_.size() - 1;
+  size_ = 0;
+  for (const Entry& e : old)
+    if (e.v != kNone) insert(e.key, e.v);
+}
+
+void VoxelMap::Table::clear() {
+  slots_.clear();
+  mask_ = 0;
+  size_ = 0;
 }
 
 VoxelMap::VoxelMap(const VoxelMapParams& p) : params_(params::require_valid(p, "VoxelMapParams")) {
@@ -101,7 +153,7 @@ std::uint32_t VoxelMap::add_voxel(const Key& key) {
   Voxel& x = pool_[v];
   x.key = key;
   x.live = true;
-  index_.emplace(key, v);
+  index_.insert(key, v);
   push_front(v);
   return v;
 }
@@ -147,8 +199,8 @@ VoxelMap::InsertResult VoxelMap::insert(const std::vector<Eigen::Vector3d>& poin
     }
     const Slot slot{f[0], f[1], f[2], number};
 
-    const auto it = index_.find(key);
-    if (it == index_.end()) {
+    const std::uint32_t v = index_.find(key);
+    if (v == kNone) {
       if (index_.size() >= static_cast<std::size_t>(params_.max_voxels)) {
         drop_voxel(tail_);
         ++r.evicted_voxels;
@@ -158,7 +210,6 @@ VoxelMap::InsertResult VoxelMap::insert(const std::vector<Eigen::Vector3d>& poin
       ++r.added;
       continue;
     }
-    const std::uint32_t v = it->second;
     if (v != head_) {
       unlink(v);
       push_front(v);
@@ -218,9 +269,9 @@ int VoxelMap::knn(const Eigen::Vector3d& query, int k, double max_distance, std:
     const double box2 = gap2[0][o.x + 1] + gap2[1][o.y + 1] + gap2[2][o.z + 1];
     const double bound = out.size() == kk ? std::min(limit, out.back().distance2) : limit;
     if (box2 > bound) continue;
-    const auto it = index_.find({qk.x + o.x, qk.y + o.y, qk.z + o.z});
-    if (it == index_.end()) continue;
-    for (const Slot& s : pool_[it->second].points) {
+    const std::uint32_t v = index_.find({qk.x + o.x, qk.y + o.y, qk.z + o.z});
+    if (v == kNone) continue;
+    for (const Slot& s : pool_[v].points) {
       const double dx = static_cast<double>(s.x) - q[0];
       const double dy = static_cast<double>(s.y) - q[1];
       const double dz = static_cast<double>(s.z) - q[2];

@@ -60,7 +60,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -146,12 +145,32 @@ class VoxelMap {
   void clear();
 
  private:
+  static constexpr std::uint32_t kNone = 0xffffffffu;
   struct Key {
     std::int32_t x, y, z;
     bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
   };
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const;
+  // voxel key -> pool slot: open addressing with linear probing in a
+  // power-of-two array at most half full, deletion by backward shift (no
+  // tombstones); one probe is one 16-byte entry, four to a cache line
+  class Table {
+   public:
+    std::uint32_t find(const Key& k) const;  // kNone when absent
+    void insert(const Key& k, std::uint32_t v);  // k absent
+    void erase(const Key& k);                    // k present
+    std::size_t size() const { return size_; }
+    void clear();
+
+   private:
+    struct Entry {
+      Key key;
+      std::uint32_t v = kNone;
+    };
+    std::size_t home(const Key& k) const;
+    void grow();
+    std::vector<Entry> slots_;
+    std::size_t mask_ = 0;
+    std::size_t size_ = 0;
   };
   struct Slot {
     float x, y, z;
@@ -163,8 +182,6 @@ class VoxelMap {
     bool live = false;
     std::vector<Slot> points;
   };
-  static constexpr std::uint32_t kNone = 0xffffffffu;
-
   // the leaf and voxel of a (float-rounded) point; false when out of range
   bool locate(const double p[3], std::int64_t leaf[3], Key& voxel) const;
   std::uint32_t add_voxel(const Key& key);
@@ -179,7 +196,7 @@ class VoxelMap {
   std::array<Key, 27> offsets_{};      // the query's voxel, faces, edges, corners
   int searched_ = 27;                  // how many of offsets_ a query visits
 
-  std::unordered_map<Key, std::uint32_t, KeyHash> index_;
+  Table index_;
   std::vector<Voxel> pool_;
   std::vector<std::uint32_t> free_;
   std::uint32_t head_ = kNone, tail_ = kNone;
