@@ -200,9 +200,9 @@ void Lio::initialise_from_rest(TimeNs t) {
   started_ = true;
 }
 
-void Lio::propagate_to(TimeNs t, std::vector<Knot>* knots) { propagate(x_, P_, t_, t, knots); }
+void Lio::propagate_to(TimeNs t, std::vector<Knot>* knots) { propagate(x_, &P_, t_, t, knots); }
 
-void Lio::propagate(LioState& x, LioMatrix& P, TimeNs& now, TimeNs t, std::vector<Knot>* knots) const {
+void Lio::propagate(LioState& x, LioMatrix* P, TimeNs& now, TimeNs t, std::vector<Knot>* knots) const {
   const LioParams& pr = params_;
   auto push = [&](TimeNs at, const Vector3d& w, const Vector3d& a) {
     if (knots) knots->push_back({at, x, w, a});
@@ -228,7 +228,7 @@ void Lio::propagate(LioState& x, LioMatrix& P, TimeNs& now, TimeNs t, std::vecto
     const Vector3d w = w_m - x.bg;
     const Vector3d a = a_m - x.ba;
     push(now, w, a);
-    if (dt > 0.0) {
+    if (dt > 0.0 && P) {
       // covariance first, about the state at the interval's start
       LioMatrix F = LioMatrix::Identity();
       F.block<3, 3>(kLioTheta, kLioTheta) = so3_exp(-w * dt);
@@ -243,7 +243,9 @@ void Lio::propagate(LioState& x, LioMatrix& P, TimeNs& now, TimeNs t, std::vecto
       Q.block<3, 3>(kLioV, kLioV) = Matrix3d::Identity() * sa * sa;
       Q.block<3, 3>(kLioBg, kLioBg) = Matrix3d::Identity() * pr.gyro_bias_walk * pr.gyro_bias_walk * dt;
       Q.block<3, 3>(kLioBa, kLioBa) = Matrix3d::Identity() * pr.accel_bias_walk * pr.accel_bias_walk * dt;
-      P = F * P * F.transpose() + Q;
+      *P = F * *P * F.transpose() + Q;
+    }
+    if (dt > 0.0) {
       // the state: exact for a constant body rate and specific force over
       // the interval (the specific force turns with the body; held at the
       // interval's start attitude it would lag by half a step's turn: a
@@ -258,11 +260,12 @@ void Lio::propagate(LioState& x, LioMatrix& P, TimeNs& now, TimeNs t, std::vecto
 
 LioState Lio::predict(TimeNs t) const {
   LioState x = x_;
-  LioMatrix P = P_;
   TimeNs at = t_;
-  if (t > at) propagate(x, P, at, t, nullptr);
+  if (t > at) propagate(x, nullptr, at, t, nullptr);
   return x;
 }
+
+Pose2 Lio::predict_base_pose(TimeNs t) const { return base_pose_of(predict(t)); }
 
 std::vector<Vector3d> Lio::deskew(const std::vector<hal::LidarPoint>& points, const Isometry3d& imu_lidar,
                                   const std::vector<Knot>& knots) {
@@ -449,13 +452,12 @@ LioStatus Lio::on_scan(const hal::LidarScan& scan) {
   return status;
 }
 
-Pose2 Lio::base_pose() const {
-  const Isometry3d world_imu = [&] {
-    Isometry3d T = Isometry3d::Identity();
-    T.linear() = x_.R;
-    T.translation() = x_.p;
-    return T;
-  }();
+Pose2 Lio::base_pose() const { return base_pose_of(x_); }
+
+Pose2 Lio::base_pose_of(const LioState& x) const {
+  Isometry3d world_imu = Isometry3d::Identity();
+  world_imu.linear() = x.R;
+  world_imu.translation() = x.p;
   const Isometry3d world_base = world_imu * imu_base_;
   const Vector3d fwd = world_base.linear().col(0);
   return {world_base.translation().x(), world_base.translation().y(), std::atan2(fwd.y(), fwd.x())};

@@ -215,8 +215,10 @@ class Lio {
   // the base's planar pose and its covariance (x, y, yaw) at the state's time
   Pose2 base_pose() const;
   Eigen::Matrix3d base_pose_covariance() const;
-  // the state propagated on the buffered IMU samples to `t` (not kept)
+  // the state propagated on the buffered IMU samples to `t` (not kept; no
+  // covariance), and the base's planar pose then
   LioState predict(TimeNs t) const;
+  Pose2 predict_base_pose(TimeNs t) const;
   // the state set to x at time t (the covariance kept): a re-anchoring, or a
   // start that is not at rest
   void reset(const LioState& x, TimeNs t);
@@ -250,8 +252,9 @@ class Lio {
   LioStatus update(const std::vector<Eigen::Vector3d>& points);
 
  private:
-  // x, P, their time t_from, on the buffered samples to `to`
-  void propagate(LioState& x, LioMatrix& P, TimeNs& t_from, TimeNs to, std::vector<Knot>* knots) const;
+  // x, P (if given), their time t_from, on the buffered samples to `to`
+  void propagate(LioState& x, LioMatrix* P, TimeNs& t_from, TimeNs to, std::vector<Knot>* knots) const;
+  Pose2 base_pose_of(const LioState& x) const;
   bool fit_plane(const Eigen::Vector3d& p_world, Eigen::Vector3d& n, double& d);
   void initialise_from_rest(TimeNs t);
 

@@ -23,6 +23,21 @@ Localisation::Localisation(const SlamParams& p, SlamMode mode, const Pose2& star
     fastslam_.emplace(p.fastslam, p.seed);
     fastslam_->reset(start);
   }
+  if (mode_ == SlamMode::Lio) {
+    // the IMU at its mounting point, the LiDAR at its own, both in the base frame
+    slam::LioExtrinsics ext;
+    ext.base_imu.translation() = Eigen::Vector3d(p.geometry.imu_x, p.geometry.imu_y, 0.0);
+    ext.base_lidar.linear() = Eigen::AngleAxisd(p.lidar.mount_pitch, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    ext.base_lidar.translation() = Eigen::Vector3d(p.lidar.mount_x, p.lidar.mount_y, p.lidar.mount_z);
+    lio_.emplace(p.lio, ext, start);
+    // the map: FastSLAM's logic with one particle that follows the LIO exactly
+    slam::FastSlamParams mapper = p.fastslam;
+    mapper.particles = 1;
+    mapper.fastslam_version = 1;
+    mapper.motion_std_xy_per_m = mapper.motion_std_yaw_per_m = mapper.motion_std_yaw_per_rad = 0.0;
+    fastslam_.emplace(mapper, p.seed);
+    fastslam_->reset(start);
+  }
   // the graph's noise models are the front end's: the same sensors
   slam::PoseGraphParams& g = params_.graph;
   const slam::FastSlamParams& f = params_.fastslam;
@@ -43,7 +58,14 @@ std::optional<hal::StateEstimate> Localisation::on_imu(const hal::Imu& m) {
     return std::nullopt;
   }
   const estimation::VelocityEstimate e = ekf_.estimate();
-  odom_.push_back({e.stamp, e.pose});
+  Pose2 odom = e.pose;
+  if (lio_) {
+    // slam = lio: the odometry is the LIO's, carried to this sample
+    lio_->on_imu(m);
+    odom = lio_->predict_base_pose(e.stamp);
+  }
+  // (slam = lio: the LIO's last state may be newer than this sample)
+  if (odom_.empty() || e.stamp > odom_.back().stamp || !lio_) odom_.push_back({e.stamp, odom});
   while (!odom_.empty() && e.stamp - odom_.front().stamp > kOdometryHistory) odom_.pop_front();
   // the frames the odometry has now reached
   while (!waiting_.empty() && waiting_.front().stamp <= e.stamp) {
@@ -55,7 +77,26 @@ std::optional<hal::StateEstimate> Localisation::on_imu(const hal::Imu& m) {
     }
     waiting_.pop_front();
   }
-  return hal::StateEstimate{e.stamp, compose(correction_, e.pose), e.vx, e.vy, e.yaw_rate};
+  return hal::StateEstimate{e.stamp, compose(correction_, odom), e.vx, e.vy, e.yaw_rate};
+}
+
+void Localisation::on_scan(const hal::LidarScan& scan) {
+  if (!lio_) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  const long degenerate = lio_->stats().degenerate_slices, too_few = lio_->stats().too_few_points;
+  const slam::LioStatus s = lio_->on_scan(scan);
+  ++stats_.lio_scans;
+  stats_.lio_degenerate_slices = lio_->stats().degenerate_slices;
+  stats_.lio_too_few_points = lio_->stats().too_few_points;
+  if (lio_->stats().degenerate_slices > degenerate) stats_.last_fault = "lio: a scan's geometry left a pose direction unobserved";
+  if (lio_->stats().too_few_points > too_few) stats_.last_fault = "lio: too few planes matched in a slice";
+  if (s == slam::LioStatus::NoImu) stats_.last_fault = "lio: a scan without IMU samples";
+  // the odometry from the LIO's corrected state on: what was predicted past
+  // it goes, the IMU samples to come carry it on
+  const TimeNs at = lio_->stamp();
+  while (!odom_.empty() && odom_.back().stamp >= at) odom_.pop_back();
+  odom_.push_back({at, lio_->base_pose()});
+  stats_.lio_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
 }
 
 void Localisation::on_wheel_speeds(const hal::WheelSpeeds& m) {
@@ -117,7 +158,8 @@ void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
     map_news_ = true;
     lost_run_ = lost_in_frame() ? lost_run_ + 1 : 0;
     if (lost_run_ > 0) ++stats_.lost_frames;
-    if (lost_run_ >= params_.relocalisation.lost_frames) relocalise_on(obs);
+    // (slam = lio: the pose is the LIO's, the cones do not move it)
+    if (lost_run_ >= params_.relocalisation.lost_frames && !lio_) relocalise_on(obs);
     if (mode_ == SlamMode::FastSlamGraph && lost_run_ == 0) {
       const bool closure = closes_loop();
       record_node(odom, closure);
@@ -248,6 +290,10 @@ double Localisation::odometry_variance() const {
 }
 
 double Localisation::position_variance() const {
+  if (lio_) {
+    const Eigen::Matrix3d c = lio_->base_pose_covariance();
+    return c(0, 0) + c(1, 1);
+  }
   if (!fastslam_) return odometry_variance();
   return slam_variance_ + std::max(0.0, odometry_variance() - odom_variance_at_frame_);
 }

@@ -12,6 +12,11 @@
 //     the odometry's, and the landmark ids it associated the node's
 //     observations with. At each loop closure the graph is optimised and
 //     the particles re-anchored on its result.
+//   lio: the LiDAR-inertial odometry (slam/lio.h) on the raw scans and the
+//     IMU is the odometry; the map is built from the frames of detections
+//     placed at its poses by FastSLAM's map logic with one particle and no
+//     motion noise (association, tentative landmarks, colour votes,
+//     removal): the pose is the LIO's, nothing corrects it.
 //
 // Loop closure: the landmarks FastSLAM started in the first
 // loop_closure.start_distance m of driving are the start's. A closure is a
@@ -43,15 +48,17 @@
 #include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
 #include "autonomy/estimation/velocity_ekf.h"
+#include "autonomy/hal/lidar_layout.h"
 #include "autonomy/hal/messages.h"
 #include "autonomy/slam/cone_map.h"
 #include "autonomy/slam/fastslam.h"
+#include "autonomy/slam/lio.h"
 #include "autonomy/slam/pose_graph.h"
 #include "autonomy/slam/relocalise.h"
 
 namespace paddock::stack {
 
-enum class SlamMode { GroundTruth, Odometry, FastSlam, FastSlamGraph };
+enum class SlamMode { GroundTruth, Odometry, FastSlam, FastSlamGraph, Lio };
 
 // [slam.loop_closure]: when the pose graph is optimised (slam = fastslam_graph)
 struct LoopClosureParams {
@@ -87,9 +94,11 @@ struct SlamParams {
   slam::PoseGraphParams graph;
   LoopClosureParams loop_closure;
   slam::RelocaliseParams relocalisation;
-  // not visited: the runner fills them from the vehicle ([vehicle]) and the
-  // scenario's seed
+  // not visited: the runner fills them from the vehicle ([vehicle]), the
+  // LiDAR's calibration ([lidar]), the scenario's [lio] and its seed
   estimation::CarGeometry geometry;
+  hal::LidarLayout lidar;
+  slam::LioParams lio;
   std::uint64_t seed = 1;
 
   template <class V>
@@ -114,6 +123,11 @@ struct LocalisationStats {
   int relocalisations = 0;  // the filter re-anchored where the frame fit the map
   int relocalisation_failures = 0;  // searches that found no pose
   long rejected_messages = 0;  // odometry messages the EKF refused (not finite, out of order)
+  // slam = lio
+  long lio_scans = 0;
+  long lio_degenerate_slices = 0;  // updated, but a pose direction unobserved
+  long lio_too_few_points = 0;     // slices not used: too few planes
+  std::vector<double> lio_ms;      // wall time of each scan's LIO (not part of any result)
   std::vector<double> update_ms;  // wall time of each SLAM update (not part of any result)
   std::string last_fault;   // the reason of the last fallback
 };
@@ -130,6 +144,8 @@ class Localisation {
   // one frame of detections (base frame at d.stamp); processed now or, when
   // newer than the odometry, once the odometry reaches its stamp
   void on_detections(const hal::ConeDetections& d);
+  // a LiDAR rotation (slam = lio; ignored otherwise)
+  void on_scan(const hal::LidarScan& scan);
 
   // mode = odometry: the stack builds its map at the poses (pose_at);
   // mode = fastslam: the map is SLAM's
@@ -143,6 +159,7 @@ class Localisation {
   // particle spread at the last frame plus what the odometry added since
   double position_variance() const;
   const slam::FastSlam* fastslam() const { return fastslam_ ? &*fastslam_ : nullptr; }
+  const slam::Lio* lio() const { return lio_ ? &*lio_ : nullptr; }
 
  private:
   struct Odom {
@@ -173,6 +190,7 @@ class Localisation {
   SlamMode mode_;
   estimation::VelocityEkf ekf_;
   std::optional<slam::FastSlam> fastslam_;
+  std::optional<slam::Lio> lio_;
   std::deque<Odom> odom_;                    // the last second of odometry, oldest first
   std::deque<hal::ConeDetections> waiting_;  // frames newer than the odometry
   Pose2 last_frame_odom_;                    // the odometry at the last processed frame

@@ -96,6 +96,9 @@ void Stack::on_message(hal::SensorMessage&& m) {
   } else if (!perception_) {
     // perception = ground_truth: the raw sensors' messages are not used
   } else if (const auto* scan = std::get_if<hal::LidarScan>(&m)) {
+    // slam = lio: the scan localises the car first, its cones are then
+    // placed at the pose it gave
+    if (localisation_) localisation_->on_scan(*scan);
     on_detections(perception_->process(*scan));
   } else if (auto* boxes = std::get_if<hal::CameraDetections>(&m)) {
     perception_->add(std::move(*boxes));

@@ -37,7 +37,8 @@ struct AutonomyModes {
       {"ground_truth", SlamMode::GroundTruth},
       {"odometry", SlamMode::Odometry},
       {"fastslam", SlamMode::FastSlam},
-      {"fastslam_graph", SlamMode::FastSlamGraph}};
+      {"fastslam_graph", SlamMode::FastSlamGraph},
+      {"lio", SlamMode::Lio}};
   static constexpr params::Choice<PlannerMode> kPlannerNames[] = {{"delaunay", PlannerMode::Delaunay},
                                                                   {"oracle", PlannerMode::Oracle}};
   PerceptionMode perception = PerceptionMode::GroundTruth;

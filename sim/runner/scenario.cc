@@ -193,6 +193,8 @@ std::string as_section_key(const std::string& problem) {
 }  // namespace
 
 std::string Scenario::check() const {
+  if (autonomy.slam == stack::SlamMode::Lio && autonomy.perception == stack::PerceptionMode::GroundTruth)
+    return "autonomy.slam = lio needs the LiDAR's scans: autonomy.perception = lidar or lidar_camera";
   const double limit = vehicle::stable_step_limit(vehicle);
   if (1.0 / sim.physics_rate <= limit) return "";
   return "sim.physics_rate must be at least " + std::to_string(static_cast<int>(std::ceil(1.0 / limit))) +
@@ -328,6 +330,8 @@ stack::StackParams stack_params(const Scenario& s) {
   p.planning = s.planning;
   p.slam = s.slam;
   p.slam.geometry = car_geometry(v, s.imu);
+  p.slam.lidar = static_cast<const hal::LidarLayout&>(s.lidar);
+  p.slam.lio = s.lio;
   p.slam.seed = stream_seed(s.scenario.seed, "slam");
   p.planning.reference.profile.mass = v.mass;
   p.planning.reference.profile.drag_coefficient = v.c_drag;

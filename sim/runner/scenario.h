@@ -130,6 +130,7 @@ struct Scenario {
   stack::MissionParams mission;
   stack::GateParams gates;
   stack::SlamParams slam;
+  slam::LioParams lio;
   // the simulation itself, and what a CI run must achieve
   SimSection sim;
   Expectations expect;
@@ -157,6 +158,7 @@ struct Scenario {
     v.section(PADDOCK_PARAM(mission), "the stack's mission logic");
     v.section(PADDOCK_PARAM(gates), "the timekeeping gates the stack learns from big orange cones");
     v.section(PADDOCK_PARAM(slam), "the stack's own state estimation (slam != ground_truth)");
+    v.section(PADDOCK_PARAM(lio), "the LiDAR-inertial odometry (slam = lio)");
     v.section(PADDOCK_PARAM(sim), "the simulation's rates");
     v.section(PADDOCK_PARAM(expect), "what a CI scenario must achieve (unset entries are not checked)");
   }

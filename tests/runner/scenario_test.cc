@@ -184,6 +184,11 @@ TEST(Scenario, TheStableStepLimitIsTheCarsFastestMode) {
   EXPECT_NEAR(vehicle::stable_step_limit(v), 0.0055, 0.0003);
 }
 
+TEST_F(ScenarioFile, LioWithoutTheLidarSaysWhatItNeeds) {
+  EXPECT_THAT(error_of(write(std::string(kHead) + "[autonomy]\nperception = ground_truth\nslam = lio\n")),
+              HasSubstr(".ini: [autonomy] slam = lio needs the LiDAR's scans: autonomy.perception = lidar or lidar_camera"));
+}
+
 TEST_F(ScenarioFile, AnOldKeyNamesItsNewPlace) {
   EXPECT_THAT(error_of(write(std::string(kHead) + "[control]\nstanley_k = 2\n")),
               HasSubstr(":5: unknown key 'stanley_k' in [control]; it is now [control.stanley] k"));

@@ -222,6 +222,27 @@ TEST(Simulation, WithFastSlamTheCarLocalisesOnItsOwnMap) {
   EXPECT_EQ(again.slam.ate_rms, r.slam.ate_rms);
 }
 
+TEST(Simulation, WithTheLioTheCarLocalisesOnTheRawScans) {
+  // slam = lio: the LiDAR-inertial odometry on the raw scans and the six-axis
+  // IMU gives the pose, FastSLAM's map logic places the cones at it
+  const ScenarioOnTrack& s = default_setup();
+  Scenario lio = s.scenario;
+  lio.autonomy.slam = stack::SlamMode::Lio;
+  const RunResult r = run(lio, s.track);
+  ASSERT_FALSE(r.log.empty());
+  EXPECT_GT(std::hypot(r.log.back().x - r.log.front().x, r.log.back().y - r.log.front().y), 20.0);
+  EXPECT_GT(r.slam.frames, 40);
+  EXPECT_LT(r.slam.ate_rms, 0.1);
+  EXPECT_LT(r.slam.ate_max, 0.3);
+  EXPECT_GT(r.slam.map.map_cones, 20);
+  EXPECT_GE(r.slam.map.precision, 0.95);
+  EXPECT_LT(r.slam.map.rmse, 0.15);
+  EXPECT_EQ(r.fallbacks, 0);
+  const RunResult again = run(lio, s.track);
+  ASSERT_EQ(again.log.size(), r.log.size());
+  EXPECT_EQ(again.log.back().x, r.log.back().x);
+}
+
 TEST(Simulation, WithTheGraphTheLoopClosesAndTheMapImproves) {
   // slam = fastslam_graph, one autocross lap on the object-level sensor: the
   // car back at the start closes the loop once, the graph's optimisation
