@@ -151,10 +151,16 @@ SlamMetrics SlamScorer::metrics(const SimModel& model, const SimState& state, co
     m.lost_frames = st.lost_frames;
     m.relocalisations = st.relocalisations;
     m.rejected_messages = st.rejected_messages;
+    const std::vector<double>& ms = loc->lio() ? st.lio_ms : st.update_ms;
     double sum = 0.0;
-    for (double x : st.update_ms) sum += x;
-    m.update_ms_mean = st.update_ms.empty() ? 0.0 : sum / static_cast<double>(st.update_ms.size());
-    m.update_ms_p99 = percentile(st.update_ms, 0.99);
+    for (double x : ms) sum += x;
+    m.update_ms_mean = ms.empty() ? 0.0 : sum / static_cast<double>(ms.size());
+    m.update_ms_p99 = percentile(ms, 0.99);
+    if (const slam::Lio* lio = loc->lio()) {
+      m.lio_slices = lio->stats().slices;
+      m.lio_degenerate_slices = st.lio_degenerate_slices;
+      m.lio_too_few_points = st.lio_too_few_points;
+    }
   }
   if (n_ == 0) return m;
   m.ate_rms = std::sqrt(sum2_ / static_cast<double>(n_));

@@ -90,6 +90,10 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
       << " refused odometry messages, " << r.slam.loop_closures << " loop closures; update "
       << fixed(r.slam.update_ms_mean, 2) << " ms mean, " << fixed(r.slam.update_ms_p99, 2) << " ms p99\n";
   }
+  if (s.autonomy.slam == stack::SlamMode::Lio) {
+    o << "              lio: " << r.slam.lio_slices << " slices, " << r.slam.lio_degenerate_slices
+      << " with a pose direction unobserved, " << r.slam.lio_too_few_points << " with too few planes\n";
+  }
   o << "  energy      " << fixed(r.energy / 3600.0, 1) << " Wh drawn from the accumulator over the run (regeneration counted off)\n";
   if (r.perception.frames() > 0) {
     o << "  perception  " << stack::to_string(s.autonomy.perception) << ", " << r.perception.frames()
@@ -145,6 +149,9 @@ nlohmann::json slam_json(const Scenario& s, const SlamMetrics& m) {
           {"rejected_messages", m.rejected_messages},
           {"update_ms_mean", m.update_ms_mean},
           {"update_ms_p99", m.update_ms_p99},
+          {"lio_slices", m.lio_slices},
+          {"lio_degenerate_slices", m.lio_degenerate_slices},
+          {"lio_too_few_points", m.lio_too_few_points},
           {"laps", laps}};
 }
 }  // namespace
