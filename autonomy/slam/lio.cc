@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <unordered_set>
 
 #include <Eigen/Cholesky>
@@ -162,6 +163,7 @@ Lio::Lio(const LioParams& params, const LioExtrinsics& extrinsics, const Pose2& 
 }
 
 void Lio::reset(const LioState& x, TimeNs t) {
+  ++generation_;
   x_ = x;
   t_ = t;
   started_ = true;
@@ -200,7 +202,10 @@ void Lio::initialise_from_rest(TimeNs t) {
   started_ = true;
 }
 
-void Lio::propagate_to(TimeNs t, std::vector<Knot>* knots) { propagate(x_, &P_, t_, t, knots); }
+void Lio::propagate_to(TimeNs t, std::vector<Knot>* knots) {
+  propagate(x_, &P_, t_, t, knots);
+  ++generation_;
+}
 
 void Lio::propagate(LioState& x, LioMatrix* P, TimeNs& now, TimeNs t, std::vector<Knot>* knots) const {
   const LioParams& pr = params_;
@@ -265,7 +270,18 @@ LioState Lio::predict(TimeNs t) const {
   return x;
 }
 
-Pose2 Lio::predict_base_pose(TimeNs t) const { return base_pose_of(predict(t)); }
+Pose2 Lio::predict_base_pose(TimeNs t) {
+  // carried on from the last prediction while the state is unchanged (the
+  // IMU rate calls this once per sample: one interval each, not all since
+  // the last scan)
+  if (front_of_ != generation_ || front_t_ > t) {
+    front_x_ = x_;
+    front_t_ = t_;
+    front_of_ = generation_;
+  }
+  if (t > front_t_) propagate(front_x_, nullptr, front_t_, t, nullptr);
+  return base_pose_of(front_x_);
+}
 
 std::vector<Vector3d> Lio::deskew(const std::vector<hal::LidarPoint>& points, const Isometry3d& imu_lidar,
                                   const std::vector<Knot>& knots) {
@@ -275,16 +291,23 @@ std::vector<Vector3d> Lio::deskew(const std::vector<hal::LidarPoint>& points, co
   const Knot& end = knots.back();
   const Matrix3d Re_t = end.x.R.transpose();
   std::size_t k = 0;
+  TimeNs at = std::numeric_limits<TimeNs>::min();
+  Matrix3d Rc;  // end <- IMU at the point's time, and the IMU's origin there
+  Vector3d tc;
   for (const hal::LidarPoint& q : points) {
-    // the interval [knots[k], knots[k+1]) holding the point's time (points in time order)
-    while (k + 1 < knots.size() && knots[k + 1].t <= q.t) ++k;
-    const Knot& a = knots[k];
-    const double tau = to_seconds(q.t - a.t);
-    Vector3d pi, vi;
-    Matrix3d Ri;
-    moved(a.x, a.omega, a.accel, tau, pi, vi, Ri);
-    const Vector3d p_imu = imu_lidar * Vector3d(q.x, q.y, q.z);
-    out.push_back(Re_t * (Ri * p_imu + pi - end.x.p));
+    if (q.t != at) {
+      // the interval [knots[k], knots[k+1]) holding the point's time (points
+      // in time order; a column's points share theirs)
+      while (k + 1 < knots.size() && knots[k + 1].t <= q.t) ++k;
+      const Knot& a = knots[k];
+      Vector3d pi, vi;
+      Matrix3d Ri;
+      moved(a.x, a.omega, a.accel, to_seconds(q.t - a.t), pi, vi, Ri);
+      Rc = Re_t * Ri;
+      tc = Re_t * (pi - end.x.p);
+      at = q.t;
+    }
+    out.push_back(Rc * (imu_lidar * Vector3d(q.x, q.y, q.z)) + tc);
   }
   return out;
 }
@@ -314,7 +337,8 @@ bool Lio::fit_plane(const Vector3d& p_world, Vector3d& n, double& d) {
     const Vector3d e = nn_[static_cast<std::size_t>(i)].point - c;
     S += e * e.transpose();
   }
-  Eigen::SelfAdjointEigenSolver<Matrix3d> es(S);
+  Eigen::SelfAdjointEigenSolver<Matrix3d> es;
+  es.computeDirect(S);
   n = es.eigenvectors().col(0);
   if (!n.allFinite() || n.norm() < 0.5) return false;
   n.normalize();
@@ -355,6 +379,7 @@ LioStatus Lio::update(const std::vector<Vector3d>& points) {
     stats_.last_matches = matches;
     if (matches < pr.min_matches) {
       x_ = prior;
+      ++generation_;
       return LioStatus::TooFewPoints;
     }
     info = HtH;
@@ -368,6 +393,7 @@ LioStatus Lio::update(const std::vector<Vector3d>& points) {
     rhs.head<6>() = -Htz * inv_s2 + HtH * inv_s2 * dx_prior.head<6>();
     const LioVector step = A_ldlt.solve(rhs) - dx_prior;
     x_ = boxplus(x_, step);
+    ++generation_;
     ++stats_.iterations;
     converged = step.norm() < pr.convergence;
     HtH_last.setZero();

@@ -218,7 +218,7 @@ class Lio {
   // the state propagated on the buffered IMU samples to `t` (not kept; no
   // covariance), and the base's planar pose then
   LioState predict(TimeNs t) const;
-  Pose2 predict_base_pose(TimeNs t) const;
+  Pose2 predict_base_pose(TimeNs t);
   // the state set to x at time t (the covariance kept): a re-anchoring, or a
   // start that is not at rest
   void reset(const LioState& x, TimeNs t);
@@ -270,6 +270,11 @@ class Lio {
   std::deque<hal::Imu> imu_;  // buffered samples, oldest first (the one at or before t_ kept)
   VoxelMap map_;
   LioStats stats_;
+  // predict_base_pose's state, carried on from the state of generation
+  // front_of_ (the state's generation counts its changes)
+  std::uint64_t generation_ = 1, front_of_ = 0;
+  LioState front_x_;
+  TimeNs front_t_ = 0;
   // scratch
   std::vector<VoxelMap::Neighbour> nn_;
 };
