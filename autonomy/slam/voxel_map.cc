@@ -22,7 +22,12 @@ bool before(double d2, const Eigen::Vector3d& p, const VoxelMap::Neighbour& b) {
   return p.z() < b.point.z();
 }
 
-std::int64_t floor_div(std::int64_t a, std::int64_t n) { return a >= 0 ? a / n : -((-a + n - 1) / n); }
+// floor(x) for |x| < 2^62, inline (std::floor is a call into libm on x86-64
+// without SSE4.1): truncation, one down for a negative non-integer
+std::int64_t floor_int(double x) {
+  const std::int64_t t = static_cast<std::int64_t>(x);
+  return x < static_cast<double>(t) ? t - 1 : t;
+}
 
 }  // namespace
 
@@ -100,7 +105,8 @@ void VoxelMap::Table::clear() {
 
 VoxelMap::VoxelMap(const VoxelMapParams& p) : params_(params::require_valid(p, "VoxelMapParams")) {
   leaves_per_voxel_ = static_cast<std::int64_t>(std::round(params_.voxel_size / params_.leaf_size));
-  voxel_ = static_cast<double>(leaves_per_voxel_) * params_.leaf_size;
+  per_voxel_ = static_cast<double>(leaves_per_voxel_);
+  voxel_ = per_voxel_ * params_.leaf_size;
   max_coord_ = params_.leaf_size * 1073741824.0;  // 2^30 leaves
   // the query's voxel, then the faces, the edges, the corners: nearest boxes first
   int n = 0;
@@ -116,8 +122,12 @@ bool VoxelMap::locate(const double p[3], std::int64_t leaf[3], Key& voxel) const
   std::int32_t key[3];
   for (int a = 0; a < 3; ++a) {
     if (!(std::abs(p[a]) < max_coord_)) return false;  // NaN too
-    leaf[a] = static_cast<std::int64_t>(std::floor(p[a] / params_.leaf_size));
-    key[a] = static_cast<std::int32_t>(floor_div(leaf[a], leaves_per_voxel_));
+    leaf[a] = floor_int(p[a] / params_.leaf_size);
+    // floor(leaf / n) in doubles: exact, as |leaf| < 2^30 and n <= 1000 (an
+    // integer quotient stays one, any other lies at least 1/n below the
+    // next integer, far more than a rounding at 2^30), and cheaper than a
+    // 64-bit integer division
+    key[a] = static_cast<std::int32_t>(floor_int(static_cast<double>(leaf[a]) / per_voxel_));
   }
   voxel = {key[0], key[1], key[2]};
   return true;
