@@ -37,6 +37,20 @@ TEST(GaussianTable, QuantilesAreThoseOfTheNormal) {
   EXPECT_LT(std, 1.0);  // the cut tails take a little of the variance
 }
 
+TEST(GaussianTable, FillGivesTheStreamsDraws) {
+  // blocks of every length mod 5, from every position in a word
+  GaussianStream a(777), b(777);
+  std::vector<double> block;
+  for (std::size_t n : {0u, 1u, 2u, 3u, 4u, 5u, 6u, 7u, 11u, 64u, 3u, 320u, 9u}) {
+    block.assign(n, 0.0);
+    a.fill(block.data(), n);
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(block[i], b()) << "block of " << n << ", draw " << i;
+    }
+  }
+  EXPECT_EQ(a(), b());
+}
+
 TEST(GaussianTable, StreamDrawsAreStandardNormal) {
   GaussianStream g(12345);
   const int n = 1 << 22;  // 4 M draws
