@@ -1,8 +1,12 @@
 #include "sim/sensors/lidar.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <cstring>
 #include <limits>
+
+#include <immintrin.h>
 
 #include "sim/sensors/embree_ray.h"
 #include "sim/sensors/gaussian_table.h"
@@ -34,6 +38,125 @@ void check(RTCDevice device, const char* what) {
 constexpr int kConeVertices = 2 * kConeSegments + 1;  // base ring, top ring, top centre
 constexpr int kConeTriangles = 3 * kConeSegments;     // lateral quads (2 each), top fan
 
+// Embree's reciprocal 1 / a as its kernels take it (common/simd/vfloat{4,8,16}_*.h,
+// Embree 3.13): an estimate r refined by one Newton step r + r (1 - a r). Which
+// estimate and whether the step is fused depends on the ISA Embree picks at
+// run time: rcp14 and fused with AVX-512, rcp and fused with AVX2, rcp and
+// unfused below. Each candidate below is one of these; LidarWorld keeps the
+// one that reproduces Embree's own hits (probe_quad_rcp). n: a multiple of 4.
+using RcpFn = void (*)(const float* a, float* out, std::size_t n);
+
+__attribute__((target("avx512f,avx512vl,fma"))) void rcp_avx512(const float* a, float* out,
+                                                                 std::size_t n) {
+  const __m128 one = _mm_set1_ps(1.0f);
+  for (std::size_t i = 0; i < n; i += 4) {
+    const __m128 x = _mm_loadu_ps(a + i);
+    const __m128 r = _mm_rcp14_ps(x);
+    _mm_storeu_ps(out + i, _mm_fmadd_ps(r, _mm_fnmadd_ps(x, r, one), r));
+  }
+}
+
+__attribute__((target("avx2,fma"))) void rcp_avx2(const float* a, float* out, std::size_t n) {
+  const __m128 one = _mm_set1_ps(1.0f);
+  for (std::size_t i = 0; i < n; i += 4) {
+    const __m128 x = _mm_loadu_ps(a + i);
+    const __m128 r = _mm_rcp_ps(x);
+    _mm_storeu_ps(out + i, _mm_fmadd_ps(r, _mm_fnmadd_ps(x, r, one), r));
+  }
+}
+
+void rcp_sse(const float* a, float* out, std::size_t n) {
+  const __m128 one = _mm_set1_ps(1.0f);
+  for (std::size_t i = 0; i < n; i += 4) {
+    const __m128 x = _mm_loadu_ps(a + i);
+    const __m128 r = _mm_rcp_ps(x);
+    _mm_storeu_ps(out + i, _mm_add_ps(r, _mm_mul_ps(r, _mm_sub_ps(one, _mm_mul_ps(x, r)))));
+  }
+}
+
+// the flat ground in closed form: Embree's Moeller-Trumbore test
+// (kernels/geometry/triangle_intersector_moeller.h, Embree 3.13) of a ray
+// (org, dir in float) against a quad triangle, v0 = (x0, y0, 0), whose
+// geometric normal is Ng = (0, 0, ng) (LidarWorld::quad_ng_). With C = v0 -
+// org, C.z = 0 - oz exactly:
+//   den = dot(Ng, dir) = ng dz,   T = dot(Ng, C) ^ sign(den) = (ng C.z) ^ sign(den)
+// (dot's other terms are exact zeros, fused or not, so each is one rounded
+// product), and the ray hits when den != 0 and 0 = |den| tnear < T <= |den| tfar,
+// at t = T rcp(|den|). The edge tests pass wherever the hit lies inside the
+// quad (on the diagonal one triangle's U is the other's -V, so one passes);
+// the callers keep to hits well inside. num[j] = T, den[j] = |den|; hit when
+// den[j] != 0 and 0 < num[j] <= den[j] tfar.
+void quad_terms(float ng, float oz, const float* dz, float* num, float* den, std::size_t n) {
+  const float p = ng * (0.0f - oz);
+  for (std::size_t j = 0; j < n; ++j) {
+    const float d = ng * dz[j];
+    den[j] = std::fabs(d);
+    num[j] = std::signbit(d) ? -p : p;
+  }
+}
+
+// which candidate reciprocal reproduces Embree's hits on the flat ground of
+// `scene` (the quad x0 .. x1, y0 .. y1 with normal ng): 64 probe rays cast
+// down onto the margin of the quad, 250 m in from its corner (500 m from the
+// cones, which they cannot reach), at several heights and slopes
+RcpFn probe_quad_rcp(RTCScene scene, float x0, float y0, float ng) {
+  std::vector<RcpFn> candidates;
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+      __builtin_cpu_supports("fma")) {
+    candidates.push_back(rcp_avx512);
+  }
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    candidates.push_back(rcp_avx2);
+  }
+  candidates.push_back(rcp_sse);
+
+  constexpr int kProbes = 64;
+  const float tfar = 1000.0f;
+  float oz[kProbes], dz[kProbes], t[kProbes];
+  bool hit[kProbes];
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  std::uint64_t state = 0x5eed;
+  for (int p0 = 0; p0 < kProbes; p0 += 16) {
+    alignas(64) int valid[16];
+    alignas(64) RTCRayHit16 rh;
+    for (int j = 0; j < 16; ++j) {
+      const int k = p0 + j;
+      // heights 0.05 .. 3 m, depressions with |dz| 0.1 .. 1 of varied mantissas
+      const double u = static_cast<double>(splitmix64(state) >> 11) * 0x1.0p-53;
+      const double v = static_cast<double>(splitmix64(state) >> 11) * 0x1.0p-53;
+      const double el = 0.1 + 1.4 * u, az = 6.283185307179586 * v;
+      const double org[3] = {static_cast<double>(x0) + 250.0, static_cast<double>(y0) + 250.0,
+                             0.05 + 2.95 * static_cast<double>(k) / kProbes};
+      const double dir[3] = {std::cos(el) * std::cos(az), std::cos(el) * std::sin(az),
+                             -std::sin(el)};
+      valid[j] = -1;
+      set_ray(rh, j, org, dir, 0.0f, tfar);
+      oz[k] = rh.ray.org_z[j];
+      dz[k] = rh.ray.dir_z[j];
+    }
+    rtcIntersect16(valid, scene, &context, &rh);
+    for (int j = 0; j < 16; ++j) {
+      hit[p0 + j] = rh.hit.geomID[j] != RTC_INVALID_GEOMETRY_ID;
+      t[p0 + j] = rh.ray.tfar[j];
+    }
+  }
+  for (const RcpFn f : candidates) {
+    bool same = true;
+    for (int k = 0; k < kProbes && same; ++k) {
+      alignas(16) float num[4], den[4], r[4];
+      quad_terms(ng, oz[k], &dz[k], num, den, 1);
+      den[1] = den[2] = den[3] = 1.0f;
+      f(den, r, 4);
+      const bool h = den[0] != 0.0f && 0.0f < num[0] && num[0] <= den[0] * tfar;
+      const float tk = num[0] * r[0];
+      same = h == hit[k] && (!h || std::memcmp(&tk, &t[k], sizeof tk) == 0);
+    }
+    if (same) return f;
+  }
+  return nullptr;
+}
 
 }  // namespace
 
@@ -149,6 +272,15 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
       const float x0 = static_cast<float>(lo_x - m), x1 = static_cast<float>(hi_x + m);
       const float y0 = static_cast<float>(lo_y - m), y1 = static_cast<float>(hi_y + m);
       const float quad[12] = {x0, y0, 0.0f, x1, y0, 0.0f, x1, y1, 0.0f, x0, y1, 0.0f};
+      quad_x0_ = x0;
+      quad_x1_ = x1;
+      quad_y0_ = y0;
+      quad_y1_ = y1;
+      // Embree's Ng = cross(e2, e1) of triangle (0, 1, 2), e1 = v0 - v1 = (x0 - x1, 0, 0),
+      // e2 = v2 - v0 = (x1 - x0, y1 - y0, 0): z = e2.x e1.y - e2.y e1.x = (y1 - y0)(x1 - x0)
+      // (e2.x e1.y is an exact 0, fused or not); triangle (0, 2, 3) gives the same
+      const float ax = x1 - x0, ay = y1 - y0;
+      quad_ng_ = ay * ax;
       std::copy(quad, quad + 12, v);
       const unsigned tris[6] = {0, 1, 2, 0, 2, 3};
       std::copy(tris, tris + 6, idx);
@@ -250,6 +382,21 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
           put(vk + 3 * (kConeSegments + s), kConeApexRadius * ca, kConeApexRadius * sa, h);
         }
         put(vk + 3 * (2 * kConeSegments), 0.0, 0.0, h);
+        // its bounds, from the float vertices
+        double lo[3] = {vk[0], vk[1], vk[2]}, hi[3] = {vk[0], vk[1], vk[2]};
+        for (int q = 1; q < kConeVertices; ++q) {
+          for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], static_cast<double>(vk[3 * q + a]));
+            hi[a] = std::max(hi[a], static_cast<double>(vk[3 * q + a]));
+          }
+        }
+        Bounds b{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]),
+                 0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]), 0.5 * (hi[2] - lo[2]), 0.0};
+        for (int q = 0; q < kConeVertices; ++q) {
+          const double dx = vk[3 * q] - b.x, dy = vk[3 * q + 1] - b.y, dz = vk[3 * q + 2] - b.z;
+          b.r = std::max(b.r, std::sqrt(dx * dx + dy * dy + dz * dz));
+        }
+        bounds_.push_back(b);
         const auto base = static_cast<unsigned>(kConeVertices * k);
         unsigned* ik = idx + 3 * kConeTriangles * k;
         const auto segs = static_cast<unsigned>(kConeSegments);
@@ -272,6 +419,7 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
 
     rtcCommitScene(scene_);
     check(device_, "rtcCommitScene");
+    if (flat(ground_)) quad_rcp_ = probe_quad_rcp(scene_, quad_x0_, quad_y0_, quad_ng_);
   } catch (...) {
     if (scene_ != nullptr) rtcReleaseScene(scene_);
     rtcReleaseDevice(device_);
@@ -311,6 +459,8 @@ LidarMaterial LidarWorld::material_of(unsigned geom_id, unsigned prim_id, double
 
 Lidar::Lidar(const LidarParams& params, std::uint64_t seed) : params_(params), rng_(seed) {
   params::require_valid(params_, "LidarParams");
+  cos_pitch_ = std::cos(params_.mount_pitch);
+  sin_pitch_ = std::sin(params_.mount_pitch);
   const auto nch = static_cast<std::size_t>(params_.channels);
   const auto ncol = static_cast<std::size_t>(params_.columns);
   cos_el_.resize(nch);
@@ -341,93 +491,516 @@ TimeNs Lidar::column_time(TimeNs start, int c) const {
   return start + period_ns() * c / params_.columns;
 }
 
+// --------------------------------------------------------------------- scan
+//
+// A scan in three steps. (1) The columns' poses and the rays' origins. (2)
+// LidarCast::Exploit over flat ground: the beams that may meet a cone
+// (find_windows), cast through the whole scene (cast_windows). (3) Column by
+// column: each beam's return (true range, object, intensity before the
+// noise): through the whole scene for Packets and Single, and for Exploit
+// where the closed form does not serve; else the ground's in closed form and
+// the window beams' from (2). Then the column's points with their draws, ring
+// by ring, so that the draws are the same however the beams were cast.
+
+namespace {
+
+// a beam's direction: in the sensor frame (elevation cos ce, sin ce; azimuth
+// cos ca, sin ca), and in the world as Embree gets it (float): the pitch
+// (cos cp, sin cp) about the sensor's y, then the base's yaw (cos cy, sin cy)
+inline void beam_dir(double ce, double se, double ca, double sa, double cp, double sp, double cy,
+                     double sy, double sensor[3], float world[3]) {
+  const double dx = ce * ca, dy = ce * sa, dz = se;
+  sensor[0] = dx;
+  sensor[1] = dy;
+  sensor[2] = dz;
+  const double px = cp * dx + sp * dz, pz = -sp * dx + cp * dz;
+  world[0] = static_cast<float>(cy * px - sy * dy);
+  world[1] = static_cast<float>(sy * px + cy * dy);
+  world[2] = static_cast<float>(pz);
+}
+
+// beam_dir's world[2] alone (the yaw leaves z alone)
+inline float beam_dir_z(double ce, double se, double ca, double cp, double sp) {
+  const double dx = ce * ca, dz = se;
+  return static_cast<float>(-sp * dx + cp * dz);
+}
+
+constexpr unsigned kNoGeom = RTC_INVALID_GEOMETRY_ID;
+
+}  // namespace
+
+void Lidar::beam_directions(int c, const ColumnPose& pose) {
+  const auto cu = static_cast<std::size_t>(c);
+  ColumnBeams& b = beams_;
+  for (std::size_t j = 0; j < static_cast<std::size_t>(params_.channels); ++j) {
+    double s[3];
+    float w[3];
+    beam_dir(cos_el_[j], sin_el_[j], cos_az_[cu], sin_az_[cu], cos_pitch_, sin_pitch_, pose.cy,
+             pose.sy, s, w);
+    b.wx[j] = w[0];
+    b.wy[j] = w[1];
+    b.wz[j] = w[2];
+  }
+}
+
+namespace {
+
+// the padding of a cone's bounds: Embree's float rays and hits stray from
+// the exact ones by a few float ulps of the coordinates (the origin's, the
+// range's)
+double box_pad(const double o[3], double tfar) {
+  return 1e-3 + 1e-6 * (std::abs(o[0]) + std::abs(o[1]) + std::abs(o[2]) + tfar);
+}
+
+// v (world) in the sensor frame of a column whose yaw has cos cy, sin sy and
+// whose pitch has cos cp, sin sp: undo the yaw, then the pitch
+void to_sensor(const double v[3], double cy, double sy, double cp, double sp, double s[3]) {
+  const double h1 = cy * v[0] + sy * v[1], h2 = -sy * v[0] + cy * v[1];
+  s[0] = cp * h1 - sp * v[2];
+  s[1] = h2;
+  s[2] = sp * h1 + cp * v[2];
+}
+
+}  // namespace
+
+// The beams that may meet a cone. Column c's beams lie in the half-plane
+// {u m + w z : u >= 0} of its sensor frame, m = (cos az_c, sin az_c, 0), z the
+// up axis, and beam (c, e) is the ray of slope w / u = tan e in it. Where it
+// meets cone k's mesh, it is inside the mesh's box (padded by box_pad): so
+// the box's coordinates h (along the plane's normal n = (-sin az_c, cos
+// az_c, 0)), u and w span h = 0, and the point's w / u lies between the
+// smallest and largest w / u of the box's corners (the box projects along n
+// to the hull of its corners' (u, w), and w / u is extreme over a convex
+// polygon in u > 0 at a vertex). The rings whose tan e lies there are the
+// column's window of cone k; every ring when a corner has u <= 0 (the box
+// reaches over the sensor).
+//
+// Not every cone is tried in every column. The columns go in chunks of at
+// most pi/8 of azimuth; in the chunk's first column's frame, every column's
+// view of the cone's ball (radius r) lies within D + Y |s| of this one's (D:
+// how far the origin moves within the chunk, Y: the chord of the yaw's
+// turn), so a ball grown by that must meet the chunk's wedge of azimuths, and
+// the columns tried are those within its azimuth window asin(R' / |s_xy|),
+// one more each side.
+void Lidar::find_windows(const LidarWorld& world, float tfar) {
+  const int nch = params_.channels, ncol = params_.columns;
+  const auto nchu = static_cast<std::size_t>(nch);
+  window_.assign(nchu * static_cast<std::size_t>(ncol), 0);
+  marked_.assign(static_cast<std::size_t>(ncol), 0);
+  window_rays_.clear();
+  near_.clear();
+  const auto& bounds = world.bounds_;
+  if (bounds.empty()) return;
+  const double cp = cos_pitch_, sp = sin_pitch_;
+  const double el0 = params_.elevation_min, del = vertical_resolution();
+  const double daz = horizontal_resolution();
+  const double reach = static_cast<double>(tfar);
+  const auto pose = [this](int c) -> const ColumnPose& {
+    return poses_[static_cast<std::size_t>(c)];
+  };
+  const auto live = [&pose](int c) { return pose(c).ok && !pose(c).whole; };
+  const auto dist = [](const double a[3], const double b[3]) {
+    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                     (a[2] - b[2]) * (a[2] - b[2]));
+  };
+
+  // the cones within reach of some column: of the first live column's origin,
+  // grown by how far the origin moves in the scan
+  int first = 0;
+  while (first < ncol && !live(first)) ++first;
+  if (first == ncol) return;
+  const double* o0 = pose(first).o;
+  double moved = 0.0;
+  for (int c = first; c < ncol; ++c) {
+    if (live(c)) moved = std::max(moved, dist(pose(c).o, o0));
+  }
+  for (std::size_t k = 0; k < bounds.size(); ++k) {
+    const double b[3] = {bounds[k].x, bounds[k].y, bounds[k].z};
+    if (dist(b, o0) <= reach + bounds[k].r + box_pad(o0, reach) + moved) {
+      near_.push_back(static_cast<int>(k));
+    }
+  }
+
+  // column c's window of cone k: mark its rings
+  const auto mark = [&](int c, int k) {
+    const ColumnPose& q = pose(c);
+    const LidarWorld::Bounds& b = bounds[static_cast<std::size_t>(k)];
+    const double pad = box_pad(q.o, reach);
+    const double e[3] = {b.ex + pad, b.ey + pad, b.ez + pad};
+    const double v[3] = {b.x - q.o[0], b.y - q.o[1], b.z - q.o[2]};
+    // the column's n, m and z in the world (beam_dir's pitch and yaw)
+    const auto cu = static_cast<std::size_t>(c);
+    const double ca = cos_az_[cu], sa = sin_az_[cu];
+    const auto world_of = [&](double x, double y, double z, double out[3]) {
+      const double px = cp * x + sp * z, pz = -sp * x + cp * z;
+      out[0] = q.cy * px - q.sy * y;
+      out[1] = q.sy * px + q.cy * y;
+      out[2] = pz;
+    };
+    double n[3], m[3], z[3];
+    world_of(-sa, ca, 0.0, n);
+    world_of(ca, sa, 0.0, m);
+    world_of(0.0, 0.0, 1.0, z);
+    const auto dot = [](const double a[3], const double x[3]) {
+      return a[0] * x[0] + a[1] * x[1] + a[2] * x[2];
+    };
+    const auto spread = [&e](const double a[3]) {
+      return std::abs(a[0]) * e[0] + std::abs(a[1]) * e[1] + std::abs(a[2]) * e[2];
+    };
+    if (std::abs(dot(n, v)) > spread(n)) return;  // the box misses the plane
+    const double uc = dot(m, v), us = spread(m);
+    if (uc + us < 0.0) return;  // behind the sensor
+    if (std::sqrt(dot(v, v)) - std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]) > reach) return;
+    int lo = 0, hi = nch - 1;
+    if (uc - us > 0.0) {
+      // the corners' slopes w / u
+      const double wc = dot(z, v);
+      double lo_t = std::numeric_limits<double>::infinity(), hi_t = -lo_t;
+      for (int corner = 0; corner < 8; ++corner) {
+        double u = uc, w = wc;
+        for (int a = 0; a < 3; ++a) {
+          const double sgn = (corner >> a) & 1 ? e[a] : -e[a];
+          u += m[a] * sgn;
+          w += z[a] * sgn;
+        }
+        lo_t = std::min(lo_t, w / u);
+        hi_t = std::max(hi_t, w / u);
+      }
+      const double elo = std::atan(lo_t), ehi = std::atan(hi_t);
+      if (nch == 1) {
+        if (el0 < elo || el0 > ehi) return;
+      } else {
+        const double flo = std::clamp((elo - el0) / del, -2.0, nch + 1.0);
+        const double fhi = std::clamp((ehi - el0) / del, -2.0, nch + 1.0);
+        lo = std::max(lo, static_cast<int>(std::ceil(flo - 1e-9)));
+        hi = std::min(hi, static_cast<int>(std::floor(fhi + 1e-9)));
+      }
+    }
+    if (lo > hi) return;
+    std::uint8_t* win = window_.data() + cu * nchu;
+    for (int j = lo; j <= hi; ++j) win[j] = 1;
+    marked_[cu] = 1;
+  };
+
+  // chunks of columns
+  const int chunk = std::clamp(static_cast<int>(kPi / 8.0 / daz), 1, ncol);
+  for (int c0 = 0; c0 < ncol; c0 += chunk) {
+    const int c1 = std::min(ncol, c0 + chunk);
+    int ref = c0;
+    while (ref < c1 && !live(ref)) ++ref;
+    if (ref == c1) continue;
+    const ColumnPose& qr = pose(ref);
+    double D = 0.0, Y = 0.0;
+    for (int c = ref; c < c1; ++c) {
+      if (!live(c)) continue;
+      D = std::max(D, dist(pose(c).o, qr.o));
+      // |R(yaw_c) - R(yaw_ref)| = 2 |sin((yaw_c - yaw_ref) / 2)|, the chord
+      Y = std::max(Y, std::hypot(pose(c).cy - qr.cy, pose(c).sy - qr.sy));
+    }
+    // the wedge's edges' normals: n_a . x >= 0 and n_b . x <= 0 inside
+    const auto ua = static_cast<std::size_t>(c0), ub = static_cast<std::size_t>(c1 - 1);
+    const double na[2] = {-sin_az_[ua], cos_az_[ua]}, nb[2] = {-sin_az_[ub], cos_az_[ub]};
+    for (const int k : near_) {
+      const LidarWorld::Bounds& b = bounds[static_cast<std::size_t>(k)];
+      const double v[3] = {b.x - qr.o[0], b.y - qr.o[1], b.z - qr.o[2]};
+      const double d = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      const double R = b.r + box_pad(qr.o, reach) + 1e-6 + D + Y * d;
+      if (d - R > reach) continue;
+      double s[3];
+      to_sensor(v, qr.cy, qr.sy, cp, sp, s);
+      if (na[0] * s[0] + na[1] * s[1] < -R || nb[0] * s[0] + nb[1] * s[1] > R) continue;
+      // the columns of the ball's azimuth window, in column units [a0, a1]
+      const double rho = std::hypot(s[0], s[1]);
+      if (rho <= R || 2.0 * std::asin(R / rho) >= kPi / 2.0) {
+        for (int c = c0; c < c1; ++c) {
+          if (live(c)) mark(c, k);
+        }
+        continue;
+      }
+      const double phi = std::atan2(s[1], s[0]), beta = std::asin(R / rho);
+      const double a0 = (phi - beta + kPi) / daz - 1.0, a1 = (phi + beta + kPi) / daz + 1.0;
+      // (a1 - a0 < ncol / 4: the window meets the chunk once, maybe a turn away)
+      for (const double turn : {-1.0, 0.0, 1.0}) {
+        const double lo = std::max(static_cast<double>(c0), std::ceil(a0 + turn * ncol));
+        const double hi = std::min(static_cast<double>(c1 - 1), std::floor(a1 + turn * ncol));
+        for (int c = static_cast<int>(lo); c <= static_cast<int>(hi); ++c) {
+          if (live(c)) mark(c, k);
+        }
+      }
+    }
+  }
+
+  // the marked beams, column by column
+  for (int c = 0; c < ncol; ++c) {
+    if (marked_[static_cast<std::size_t>(c)] == 0) continue;
+    const std::uint8_t* win = window_.data() + static_cast<std::size_t>(c) * nchu;
+    for (int j = 0; j < nch; ++j) {
+      if (win[j] != 0) window_rays_.push_back({c, j, {0.0f, kNoGeom, 0u, {0.0f, 0.0f, 0.0f}}});
+    }
+  }
+}
+
+// the window beams' hits through the whole scene, in packets of 16 in their
+// order (column by column, rings ascending)
+void Lidar::cast_windows(const LidarWorld& world, float tfar) {
+  // a packet's beams are neighbours aimed at one cone: telling Embree they
+  // are coherent takes a third off its time here (the hits stay the same)
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  for (std::size_t i0 = 0; i0 < window_rays_.size(); i0 += 16) {
+    const std::size_t n = std::min<std::size_t>(16, window_rays_.size() - i0);
+    alignas(64) int valid[16];
+    alignas(64) RTCRayHit16 rh;
+    for (std::size_t j = 0; j < 16; ++j) {
+      const WindowRay& w = window_rays_[i0 + std::min(j, n - 1)];
+      const ColumnPose& q = poses_[static_cast<std::size_t>(w.column)];
+      const auto cu = static_cast<std::size_t>(w.column), ju = static_cast<std::size_t>(w.ring);
+      double sensor[3];
+      float wd[3];
+      beam_dir(cos_el_[ju], sin_el_[ju], cos_az_[cu], sin_az_[cu], cos_pitch_, sin_pitch_, q.cy,
+               q.sy, sensor, wd);
+      const double dir[3] = {wd[0], wd[1], wd[2]};
+      valid[j] = j < n ? -1 : 0;
+      set_ray(rh, static_cast<int>(j), q.o, dir, 0.0f, tfar);
+    }
+    rtcIntersect16(valid, world.scene(), &context, &rh);
+    for (std::size_t j = 0; j < n; ++j) {
+      window_rays_[i0 + j].hit = {rh.ray.tfar[j], rh.hit.geomID[j], rh.hit.primID[j],
+                                  {rh.hit.Ng_x[j], rh.hit.Ng_y[j], rh.hit.Ng_z[j]}};
+    }
+  }
+}
+
 std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
                                     const std::function<Pose2(TimeNs)>& base_pose_at,
-                                    TimeNs start) {
+                                    TimeNs start, LidarCast cast) {
   std::vector<LidarPoint> out;
-  const int nch = params_.channels;
-  out.reserve(static_cast<std::size_t>(nch) * static_cast<std::size_t>(params_.columns) / 2);
-  const double cp = std::cos(params_.mount_pitch), sp = std::sin(params_.mount_pitch);
+  const int nch = params_.channels, ncol = params_.columns;
+  const auto nchu = static_cast<std::size_t>(nch);
   const float tfar = static_cast<float>(params_.range_max + 6.0 * params_.range_noise + 0.01);
   const bool noisy = params_.range_noise > 0.0;
   const bool drops = params_.dropout > 0.0;
   const bool inoisy = params_.intensity_noise > 0.0;
+  const double range_noise = params_.range_noise, intensity_noise = params_.intensity_noise;
+  const double range_min = params_.range_min, range_max = params_.range_max;
+  const double cp = cos_pitch_, sp = sin_pitch_;
 
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  // the range and intensity noise's N(0, 1) draws (see the header)
+  // the range and intensity noise's N(0, 1) draws (see the header), taken
+  // from a buffer the stream fills in blocks
   GaussianStream normal(rng_());
+  constexpr std::size_t kDraws = 320;
+  double draws[kDraws];
+  std::size_t next_draw = kDraws;
+  const auto draw = [&]() {
+    if (next_draw == kDraws) {
+      normal.fill(draws, kDraws);
+      next_draw = 0;
+    }
+    return draws[next_draw++];
+  };
 
-  for (int c = 0; c < params_.columns; ++c) {
-    const TimeNs t = column_time(start, c);
-    const Pose2 pose = base_pose_at(t);
-    if (!finite(pose.x) || !finite(pose.y) || !finite(pose.yaw)) continue;
-    const double cy = std::cos(pose.yaw), sy = std::sin(pose.yaw);
-    const Vec2 origin = pose.transform({params_.mount_x, params_.mount_y});
-    const double oz = world.ground_z(origin.x, origin.y) + params_.mount_z;
-    const double org[3] = {origin.x, origin.y, oz};
+  // (1) the columns' poses and the rays' origins. Exploit takes flat ground
+  // in closed form when a candidate reciprocal matched Embree's (LidarWorld),
+  // except for a column whose ground hits could come within 1 m of the
+  // quad's edge (they lie within tfar of the origin): that one, and every
+  // column over a height field, goes through the whole scene.
+  const bool closed = cast == LidarCast::Exploit && world.ground_closed_form();
+  poses_.resize(static_cast<std::size_t>(ncol));
+  for (int c = 0; c < ncol; ++c) {
+    ColumnPose& q = poses_[static_cast<std::size_t>(c)];
+    q.t = column_time(start, c);
+    const Pose2 pose = base_pose_at(q.t);
+    q.ok = finite(pose.x) && finite(pose.y) && finite(pose.yaw);
+    if (!q.ok) continue;
+    q.cy = std::cos(pose.yaw);
+    q.sy = std::sin(pose.yaw);
+    // pose.transform({mount_x, mount_y}) with these cos and sin
+    q.o[0] = pose.x + (q.cy * params_.mount_x - q.sy * params_.mount_y);
+    q.o[1] = pose.y + (q.sy * params_.mount_x + q.cy * params_.mount_y);
+    q.o[2] = world.ground_z(q.o[0], q.o[1]) + params_.mount_z;
+    const double m = static_cast<double>(tfar) + 1.0;
+    q.whole = !closed || !(q.o[0] - m > world.quad_x0_ && q.o[0] + m < world.quad_x1_ &&
+                           q.o[1] - m > world.quad_y0_ && q.o[1] + m < world.quad_y1_);
+  }
+
+  // (2) the beams that may meet a cone, and their hits
+  window_rays_.clear();
+  if (closed) {
+    find_windows(world, tfar);
+    cast_windows(world, tfar);
+  }
+
+  // (3) column by column: each beam's return, then the points
+  ColumnBeams& b = beams_;
+  const std::size_t padded = (nchu + 15) / 16 * 16;
+  b.wx.assign(padded, 0.0f);
+  b.wy.assign(padded, 0.0f);
+  b.wz.assign(padded, 0.0f);
+  b.den.assign(padded, 1.0f);
+  b.num.assign(padded, 0.0f);
+  b.rcp.resize(padded);
+  b.ground.assign(padded, 0);
+  b.ground_range.resize(padded);
+  b.ground_bright.resize(padded);
+  b.oz = std::numeric_limits<float>::quiet_NaN();  // no column's yet
+  b.ok.assign(padded, 0);
+  b.range.resize(padded);
+  b.bright.resize(padded);
+  b.cone.resize(padded);
+  b.points.resize(padded);
+  out.reserve(nchu * static_cast<std::size_t>(ncol) / 2 + nchu * 64);
+  const double rho_ground = reflectivity(params_, LidarMaterial::Ground);
+
+  // the intensity before its noise, from reflectivity rho, incidence cos_inc
+  // and true range r_true (the header's model)
+  const double ref = params_.intensity_range_ref;
+  const auto lambert = [ref](double rho, double cos_inc, double r_true) {
+    const double qr = ref / std::max(r_true, 1e-9);
+    return rho * cos_inc * std::min(1.0, qr * qr);
+  };
+  // beam j of column c's return from its hit as Embree reports it: the
+  // material at the true hit point, the incidence on the hit facet
+  const auto resolve = [&](int c, std::size_t j, const float org[3], const BeamHit& h) {
+    b.ok[j] = 0;
+    if (h.geom == kNoGeom) return;
+    const std::int32_t cone = world.cone_of(h.geom, h.prim);
+    if (cone < -1) return;
     const auto cu = static_cast<std::size_t>(c);
-    const double ca = cos_az_[cu], sa = sin_az_[cu];
-    // the column's channels in packets of 16 rays (coherent: one origin, one azimuth)
-    for (int ch0 = 0; ch0 < nch; ch0 += 16) {
-      const int n = std::min(16, nch - ch0);
-      alignas(64) int valid[16];
-      alignas(64) RTCRayHit16 rh;
-      double dirs[16][3];
-      for (int j = 0; j < 16; ++j) {
-        valid[j] = j < n ? -1 : 0;
-        const auto chu = static_cast<std::size_t>(ch0 + std::min(j, n - 1));
-        // direction in the sensor frame
-        const double dx = cos_el_[chu] * ca, dy = cos_el_[chu] * sa, dz = sin_el_[chu];
-        dirs[j][0] = dx;
-        dirs[j][1] = dy;
-        dirs[j][2] = dz;
-        // pitch about the sensor's y, then the base's yaw
-        const double px = cp * dx + sp * dz, pz = -sp * dx + cp * dz;
-        const double dir[3] = {cy * px - sy * dy, sy * px + cy * dy, pz};
-        set_ray(rh, j, org, dir, 0.0f, tfar);
+    const ColumnPose& q = poses_[cu];
+    double sensor[3];
+    float dir[3];
+    beam_dir(cos_el_[j], sin_el_[j], cos_az_[cu], sin_az_[cu], cp, sp, q.cy, q.sy, sensor, dir);
+    const double r_true = static_cast<double>(h.t);  // |dir| = 1: tfar is the range
+    const double dx = dir[0], dy = dir[1], dz = dir[2];
+    const double rho =
+        cone < 0 ? rho_ground
+                 : reflectivity(params_, world.material_of(h.geom, h.prim, org[0] + r_true * dx,
+                                                           org[1] + r_true * dy,
+                                                           org[2] + r_true * dz));
+    const double nx = h.ng[0], ny = h.ng[1], nz = h.ng[2];
+    const double nn = std::sqrt(nx * nx + ny * ny + nz * nz);
+    const double cos_inc = nn > 0.0 ? std::abs(nx * dx + ny * dy + nz * dz) / nn : 0.0;
+    b.ok[j] = 1;
+    b.range[j] = r_true;
+    b.cone[j] = cone;
+    b.bright[j] = lambert(rho, cos_inc, r_true);
+  };
+
+  std::size_t next_window = 0;  // window_rays_ are in column, ring order
+  for (int c = 0; c < ncol; ++c) {
+    const ColumnPose& q = poses_[static_cast<std::size_t>(c)];
+    if (!q.ok) continue;
+    const auto cu = static_cast<std::size_t>(c);
+    const float org[3] = {static_cast<float>(q.o[0]), static_cast<float>(q.o[1]),
+                          static_cast<float>(q.o[2])};
+
+    // the returns
+    if (cast == LidarCast::Single) {
+      beam_directions(c, q);
+      for (std::size_t j = 0; j < nchu; ++j) {
+        RTCRayHit rh;
+        const double dir[3] = {b.wx[j], b.wy[j], b.wz[j]};
+        set_ray(rh, q.o, dir, 0.0f, tfar);
+        rtcIntersect1(world.scene(), &context, &rh);
+        const BeamHit h{rh.ray.tfar, rh.hit.geomID, rh.hit.primID,
+                        {rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z}};
+        resolve(c, j, org, h);
       }
-      rtcIntersect16(valid, world.scene(), &context, &rh);
-
-      for (int j = 0; j < n; ++j) {
-        if (rh.hit.geomID[j] == RTC_INVALID_GEOMETRY_ID) continue;
-        const std::int32_t cone = world.cone_of(rh.hit.geomID[j], rh.hit.primID[j]);
-        if (cone < -1) continue;
-
-        if (drops && uniform_(rng_) < params_.dropout) continue;
-        const double r_true = static_cast<double>(rh.ray.tfar[j]);  // |dir| = 1: tfar is the range
-        double r = r_true;
-        if (noisy) r += params_.range_noise * normal();
-        if (r < params_.range_min || r > params_.range_max) continue;
-
-        // intensity: material at the true hit point, incidence on the facet
-        const double wx = rh.ray.org_x[j] + r_true * rh.ray.dir_x[j];
-        const double wy = rh.ray.org_y[j] + r_true * rh.ray.dir_y[j];
-        const double wz = rh.ray.org_z[j] + r_true * rh.ray.dir_z[j];
-        const double rho = reflectivity(
-            params_, world.material_of(rh.hit.geomID[j], rh.hit.primID[j], wx, wy, wz));
-        const double nx = rh.hit.Ng_x[j], ny = rh.hit.Ng_y[j], nz = rh.hit.Ng_z[j];
-        const double nn = std::sqrt(nx * nx + ny * ny + nz * nz);
-        const double cos_inc =
-            nn > 0.0 ? std::abs(nx * rh.ray.dir_x[j] + ny * rh.ray.dir_y[j] +
-                                nz * rh.ray.dir_z[j]) / nn
-                     : 0.0;
-        const double q = params_.intensity_range_ref / std::max(r_true, 1e-9);
-        double intensity = rho * cos_inc * std::min(1.0, q * q);
-        if (inoisy) intensity += params_.intensity_noise * normal();
-        intensity = std::clamp(intensity, 0.0, 1.0);
-
-        LidarPoint p;
-        p.x = static_cast<float>(r * dirs[j][0]);
-        p.y = static_cast<float>(r * dirs[j][1]);
-        p.z = static_cast<float>(r * dirs[j][2]);
-        p.intensity = static_cast<float>(intensity);
-        p.ring = static_cast<std::uint16_t>(ch0 + j);
-        p.t = t;
-        p.cone = cone;
-        out.push_back(p);
+    } else if (q.whole) {
+      // the channels in packets of 16 (coherent: one origin, one azimuth)
+      beam_directions(c, q);
+      for (int ch0 = 0; ch0 < nch; ch0 += 16) {
+        const int n = std::min(16, nch - ch0);
+        alignas(64) int valid[16];
+        alignas(64) RTCRayHit16 rh;
+        for (int j = 0; j < 16; ++j) {
+          const auto ju = static_cast<std::size_t>(ch0 + std::min(j, n - 1));
+          const double dir[3] = {b.wx[ju], b.wy[ju], b.wz[ju]};
+          valid[j] = j < n ? -1 : 0;
+          set_ray(rh, j, q.o, dir, 0.0f, tfar);
+        }
+        rtcIntersect16(valid, world.scene(), &context, &rh);
+        for (int j = 0; j < n; ++j) {
+          resolve(c, static_cast<std::size_t>(ch0 + j), org,
+                  {rh.ray.tfar[j], rh.hit.geomID[j], rh.hit.primID[j],
+                   {rh.hit.Ng_x[j], rh.hit.Ng_y[j], rh.hit.Ng_z[j]}});
+        }
+      }
+    } else {
+      // the ground in closed form (quad_terms): only the directions' z matter
+      // there, and the incidence on Ng = (0, 0, ng) is resolve's
+      // |ng dz| / |ng| = |dz| exactly (ng dz and ng^2 are exact in double).
+      // So the ground's returns depend on the origin's z and the directions'
+      // z alone: a column that repeats the last one's (a level sensor at a
+      // steady height) repeats its returns.
+      bool same = std::memcmp(&org[2], &b.oz, sizeof b.oz) == 0;
+      if (sp != 0.0 || !same) {
+        // (with no pitch the z are every column's: -0 dx only adds a zero to dz)
+        for (std::size_t j = 0; j < nchu; ++j) {
+          const float wz = beam_dir_z(cos_el_[j], sin_el_[j], cos_az_[cu], cp, sp);
+          same = same && std::memcmp(&wz, &b.wz[j], sizeof wz) == 0;
+          b.wz[j] = wz;
+        }
+      }
+      if (!same) {
+        b.oz = org[2];
+        quad_terms(world.quad_ng_, org[2], b.wz.data(), b.num.data(), b.den.data(), nchu);
+        world.quad_rcp_(b.den.data(), b.rcp.data(), padded);
+        for (std::size_t j = 0; j < nchu; ++j) {
+          const float num = b.num[j], den = b.den[j];
+          b.ground[j] = den != 0.0f && 0.0f < num && num <= den * tfar;
+          b.ground_range[j] = static_cast<double>(num * b.rcp[j]);
+          b.ground_bright[j] =
+              lambert(rho_ground, std::abs(static_cast<double>(b.wz[j])), b.ground_range[j]);
+        }
+      }
+      std::copy(b.ground.begin(), b.ground.begin() + padded, b.ok.begin());
+      std::copy(b.ground_range.begin(), b.ground_range.begin() + padded, b.range.begin());
+      std::copy(b.ground_bright.begin(), b.ground_bright.begin() + padded, b.bright.begin());
+      std::fill(b.cone.begin(), b.cone.end(), -1);
+      // the window beams' returns (cast_windows)
+      const std::uint8_t* win = window_.data() + cu * nchu;
+      if (marked_[cu] != 0) {
+        for (std::size_t j = 0; j < nchu; ++j) {
+          if (win[j] == 0) continue;
+          const WindowRay& w = window_rays_[next_window++];
+          assert(w.column == c && static_cast<std::size_t>(w.ring) == j);
+          resolve(c, j, org, w.hit);
+        }
       }
     }
+
+    // the points, ring by ring: dropout, range noise, intensity noise;
+    // written in place into the column's scratch (a point built aside and
+    // copied in stalls on the store forwarding of its narrow fields), then
+    // appended
+    LidarPoint* dst = b.points.data();
+    const double ca = cos_az_[cu], sa = sin_az_[cu];
+    for (std::size_t j = 0; j < nchu; ++j) {
+      if (b.ok[j] == 0) continue;
+      if (drops && uniform_(rng_) < params_.dropout) continue;
+      double r = b.range[j];
+      if (noisy) r += range_noise * draw();
+      if (r < range_min || r > range_max) continue;
+      double intensity = b.bright[j];
+      if (inoisy) intensity += intensity_noise * draw();
+      // clamped to [0, 1] (std::clamp's result, without its branches)
+      intensity = std::min(std::max(intensity, 0.0), 1.0);
+      // the direction in the sensor frame as beam_dir's
+      const double ce = cos_el_[j];
+      dst->x = static_cast<float>(r * (ce * ca));
+      dst->y = static_cast<float>(r * (ce * sa));
+      dst->z = static_cast<float>(r * sin_el_[j]);
+      dst->intensity = static_cast<float>(intensity);
+      dst->ring = static_cast<std::uint16_t>(j);
+      dst->t = q.t;
+      dst->cone = b.cone[j];
+      ++dst;
+    }
+    out.insert(out.end(), b.points.data(), dst);
   }
   return out;
 }

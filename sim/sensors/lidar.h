@@ -174,6 +174,25 @@ LidarMaterial cone_material(ConeColor color, double height_fraction);
 
 // the reflectivity p assigns to material m
 double reflectivity(const LidarParams& p, LidarMaterial m);
+
+// how Lidar::scan finds each beam's first hit. All three give the same hits
+// (the same beams return, from the same cone or the ground) and ranges within
+// float rounding; see Lidar::scan.
+enum class LidarCast {
+  // the default. Over flat ground: the beams that can meet a cone (their
+  // column and ring lie in some cone's window) through the whole scene in
+  // packets of 16, the others only against the ground, in closed form. Over
+  // a height field (or a flat ground the closed form cannot serve, see
+  // LidarWorld::ground_closed_form): as Packets.
+  Exploit,
+  // every beam through the whole scene, a column's channels in packets of 16
+  // (the path before Exploit)
+  Packets,
+  // every beam through the whole scene, one rtcIntersect1 at a time: the
+  // plain reference
+  Single,
+};
+
 // the static scene: cones (BigOrange big, every other colour small) and the
 // ground. Flat ground is one quad at z = 0 that extends kGroundMargin past the
 // cones' bounding box. Any other ground is a grid of right-triangle pairs over
@@ -196,6 +215,10 @@ double reflectivity(const LidarParams& p, LidarMaterial m);
 // the ground, the top end floats a little), the middle of its axis above its
 // position. It reaches up to its base width
 // (0.228 m small, 0.285 m big).
+//
+// Besides the scene (scene(), the camera's too) it keeps what
+// LidarCast::Exploit needs: each cone mesh's bounds, and for flat ground the
+// quad as Embree holds it and Embree's reciprocal on this CPU.
 class LidarWorld {
  public:
   static constexpr double kGroundMargin = 500.0;     // m, flat ground
@@ -211,6 +234,7 @@ class LidarWorld {
   LidarWorld(const LidarWorld&) = delete;
   LidarWorld& operator=(const LidarWorld&) = delete;
 
+  // the whole scene: the ground and the cones
   RTCScene scene() const { return scene_; }
   std::size_t cone_count() const { return cone_count_; }
   const GroundParams& ground() const { return ground_; }
@@ -219,6 +243,10 @@ class LidarWorld {
   // the grid's cell actually used (0 for flat ground) and its triangle count
   double ground_cell() const { return ground_cell_; }
   std::size_t ground_triangles() const { return ground_triangles_; }
+  // whether LidarCast::Exploit takes this ground in closed form: flat, and one
+  // of the candidates for Embree's reciprocal reproduced Embree's own hits on
+  // probe rays when the world was built (lidar.cc)
+  bool ground_closed_form() const { return quad_rcp_ != nullptr; }
   // the cone index hit by (geomID, primID), -1 for the ground, -2 for nothing
   std::int32_t cone_of(unsigned geom_id, unsigned prim_id) const;
   // the material at the hit (geomID, primID) at world point (x, y, z): the
@@ -245,6 +273,27 @@ class LidarWorld {
     double ax, ay, az;
   };
   std::vector<MeshInfo> mesh_info_;
+  // LidarCast::Exploit. Mesh k's bounds, from the float vertices Embree holds
+  // (so every triangle lies inside): the box of its vertices (centre x, y, z,
+  // half-extents ex, ey, ez) and the ball about the box's centre through its
+  // farthest vertex (radius r)
+  struct Bounds {
+    double x, y, z;
+    double ex, ey, ez;
+    double r;
+  };
+  std::vector<Bounds> bounds_;
+  // flat ground: the quad's corners as Embree holds them, and the z of its
+  // triangles' geometric normal Ng = cross(e2, e1) (both triangles have
+  // Ng = (0, 0, (x1 - x0)(y1 - y0)) in float)
+  float quad_x0_ = 0.0f, quad_x1_ = 0.0f, quad_y0_ = 0.0f, quad_y1_ = 0.0f;
+  float quad_ng_ = 0.0f;
+  // flat ground: Embree's reciprocal on this CPU (lidar.cc: the candidate that
+  // reproduced Embree's own hits on probe rays), nullptr if none did (then
+  // Exploit casts every beam through Embree)
+  void (*quad_rcp_)(const float* a, float* out, std::size_t n) = nullptr;
+
+  friend class Lidar;
 };
 
 struct LidarPoint {
@@ -269,8 +318,15 @@ class Lidar {
   // dropouts, column by column, rings ascending within a column, each in the
   // sensor frame at its column's time. A column whose pose is not finite gives
   // no points (an all-NaN trajectory gives an empty scan).
+  //
+  // `cast` picks how the beams are cast (LidarCast); every choice draws the
+  // same random numbers for the same hits, so the scans agree point by point
+  // within float rounding. Exploit's ground in closed form repeats Embree's
+  // own float arithmetic (its Moeller-Trumbore test and reciprocal), so over
+  // flat ground its scan is Packets' to the bit (tests/sensors/lidar_cast_test.cc).
   std::vector<LidarPoint> scan(const LidarWorld& world,
-                               const std::function<Pose2(TimeNs)>& base_pose_at, TimeNs start);
+                               const std::function<Pose2(TimeNs)>& base_pose_at, TimeNs start,
+                               LidarCast cast = LidarCast::Exploit);
 
   const LidarParams& params() const { return params_; }
   TimeNs period_ns() const { return from_seconds(1.0 / params_.rate); }
@@ -279,6 +335,9 @@ class Lidar {
   // the angular resolutions: vertical (channel spacing) and horizontal
   double vertical_resolution() const;    // rad
   double horizontal_resolution() const;  // rad
+  // the beams the last LidarCast::Exploit scan cast through the whole scene
+  // (those in some cone's window)
+  std::size_t window_beams() const { return window_rays_.size(); }
 
  private:
   LidarParams params_;
@@ -286,6 +345,51 @@ class Lidar {
   std::uniform_real_distribution<double> uniform_{0.0, 1.0};
   // per channel: cos and sin of the elevation; per column: of the azimuth
   std::vector<double> cos_el_, sin_el_, cos_az_, sin_az_;
+  double cos_pitch_ = 1.0, sin_pitch_ = 0.0;  // of mount_pitch
+
+  // the scratch of a scan (kept to save its allocations), see lidar.cc
+  struct ColumnPose {
+    bool ok;        // a finite pose
+    bool whole;     // cast all its beams through the whole scene
+    TimeNs t;       // ns
+    double cy, sy;  // cos, sin of the yaw
+    double o[3];    // m, the rays' origin (world)
+  };
+  struct BeamHit {
+    float t;         // m, Embree's tfar
+    unsigned geom;   // RTC_INVALID_GEOMETRY_ID: no hit
+    unsigned prim;
+    float ng[3];     // the geometric normal as Embree reports it
+  };
+  struct WindowRay {
+    int column, ring;
+    BeamHit hit;
+  };
+  // a column's beams: directions in the world (as cast, float)
+  struct ColumnBeams {
+    std::vector<float> wx, wy, wz;
+    // the closed-form ground: its terms, hits, ranges and intensities before
+    // the noise, for the origin's z oz
+    std::vector<float> den, num, rcp;
+    std::vector<std::uint8_t> ground;
+    std::vector<double> ground_range, ground_bright;
+    float oz;
+    // the returns: whether there is one, its true range, cone (-1 the
+    // ground) and intensity before the noise
+    std::vector<std::uint8_t> ok;
+    std::vector<double> range, bright;
+    std::vector<std::int32_t> cone;
+    std::vector<LidarPoint> points;
+  };
+  std::vector<ColumnPose> poses_;
+  std::vector<std::uint8_t> window_;  // per beam (column by column): 1 if it may meet a cone
+  std::vector<std::uint8_t> marked_;  // per column: 1 if some beam is in window_
+  std::vector<WindowRay> window_rays_;
+  std::vector<int> near_;             // the cones in reach this scan
+  ColumnBeams beams_;
+  void beam_directions(int c, const ColumnPose& pose);
+  void find_windows(const LidarWorld& world, float tfar);
+  void cast_windows(const LidarWorld& world, float tfar);
 };
 
 }  // namespace paddock::sensors
