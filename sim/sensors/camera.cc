@@ -309,6 +309,8 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   }
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
+  // neighbouring pixels: coherent packets (Embree traverses them together)
+  context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   // the unit ray through the centre of pixel p
   const auto ray_dir = [&](std::uint32_t p, double d[3]) {
     const double a = ax_[p % static_cast<std::uint32_t>(W)], c = by_[p / static_cast<std::uint32_t>(W)];
