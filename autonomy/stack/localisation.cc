@@ -19,17 +19,19 @@ Localisation::Localisation(const SlamParams& p, SlamMode mode, const Pose2& star
     : params_(p), mode_(mode), ekf_(p.velocity, p.geometry), last_frame_odom_(start), start_(start) {
   if (mode == SlamMode::GroundTruth) throw std::invalid_argument("localisation: slam = ground_truth needs none");
   ekf_.reset(start, 0);
-  if (mode_ == SlamMode::FastSlam || mode_ == SlamMode::FastSlamGraph) {
+  if (mode_ == SlamMode::FastSlam || mode_ == SlamMode::FastSlamGraph || mode_ == SlamMode::LioGraph) {
     fastslam_.emplace(p.fastslam, p.seed);
     fastslam_->reset(start);
   }
-  if (mode_ == SlamMode::Lio) {
+  if (mode_ == SlamMode::Lio || mode_ == SlamMode::LioGraph) {
     // the IMU at its mounting point, the LiDAR at its own, both in the base frame
     slam::LioExtrinsics ext;
     ext.base_imu.translation() = Eigen::Vector3d(p.geometry.imu_x, p.geometry.imu_y, 0.0);
     ext.base_lidar.linear() = Eigen::AngleAxisd(p.lidar.mount_pitch, Eigen::Vector3d::UnitY()).toRotationMatrix();
     ext.base_lidar.translation() = Eigen::Vector3d(p.lidar.mount_x, p.lidar.mount_y, p.lidar.mount_z);
     lio_.emplace(p.lio, ext, start);
+  }
+  if (mode_ == SlamMode::Lio) {
     // the map: FastSLAM's logic with one particle that follows the LIO exactly
     slam::FastSlamParams mapper = p.fastslam;
     mapper.particles = 1;
@@ -48,7 +50,7 @@ Localisation::Localisation(const SlamParams& p, SlamMode mode, const Pose2& star
   g.motion_std_xy_per_m = f.motion_std_xy_per_m;
   g.motion_std_yaw_per_m = f.motion_std_yaw_per_m;
   g.motion_std_yaw_per_rad = f.motion_std_yaw_per_rad;
-  if (mode_ == SlamMode::FastSlamGraph) slam::PoseGraph check(g);  // throws on invalid params
+  if (graph()) slam::PoseGraph check(g);  // throws on invalid params
 }
 
 std::optional<hal::StateEstimate> Localisation::on_imu(const hal::Imu& m) {
@@ -159,8 +161,8 @@ void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
     lost_run_ = lost_in_frame() ? lost_run_ + 1 : 0;
     if (lost_run_ > 0) ++stats_.lost_frames;
     // (slam = lio: the pose is the LIO's, the cones do not move it)
-    if (lost_run_ >= params_.relocalisation.lost_frames && !lio_) relocalise_on(obs);
-    if (mode_ == SlamMode::FastSlamGraph && lost_run_ == 0) {
+    if (lost_run_ >= params_.relocalisation.lost_frames && mode_ != SlamMode::Lio) relocalise_on(obs);
+    if (graph() && lost_run_ == 0) {
       const bool closure = closes_loop();
       record_node(odom, closure);
       if (closure) optimise_graph();
@@ -290,7 +292,7 @@ double Localisation::odometry_variance() const {
 }
 
 double Localisation::position_variance() const {
-  if (lio_) {
+  if (mode_ == SlamMode::Lio) {
     const Eigen::Matrix3d c = lio_->base_pose_covariance();
     return c(0, 0) + c(1, 1);
   }

@@ -17,6 +17,9 @@
 //     placed at its poses by FastSLAM's map logic with one particle and no
 //     motion noise (association, tentative landmarks, colour votes,
 //     removal): the pose is the LIO's, nothing corrects it.
+//   lio_graph: the LIO is the odometry of fastslam_graph (FastSLAM with its
+//     particles and the pose graph on top, as above, in place of the EKF's
+//     dead reckoning): the cones and the loop closures correct its drift.
 //
 // Loop closure: the landmarks FastSLAM started in the first
 // loop_closure.start_distance m of driving are the start's. A closure is a
@@ -58,7 +61,7 @@
 
 namespace paddock::stack {
 
-enum class SlamMode { GroundTruth, Odometry, FastSlam, FastSlamGraph, Lio };
+enum class SlamMode { GroundTruth, Odometry, FastSlam, FastSlamGraph, Lio, LioGraph };
 
 // [slam.loop_closure]: when the pose graph is optimised (slam = fastslam_graph)
 struct LoopClosureParams {
@@ -176,6 +179,7 @@ class Localisation {
     Vec2 point;  // base frame
   };
   std::optional<Pose2> odometry_at(TimeNs t) const;
+  bool graph() const { return mode_ == SlamMode::FastSlamGraph || mode_ == SlamMode::LioGraph; }
   double odometry_variance() const;
   void process(const hal::ConeDetections& d, const Pose2& odom);
   // slam = fastslam_graph: the frame's node and sightings, and a closure's optimisation

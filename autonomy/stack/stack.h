@@ -38,7 +38,8 @@ struct AutonomyModes {
       {"odometry", SlamMode::Odometry},
       {"fastslam", SlamMode::FastSlam},
       {"fastslam_graph", SlamMode::FastSlamGraph},
-      {"lio", SlamMode::Lio}};
+      {"lio", SlamMode::Lio},
+      {"lio_graph", SlamMode::LioGraph}};
   static constexpr params::Choice<PlannerMode> kPlannerNames[] = {{"delaunay", PlannerMode::Delaunay},
                                                                   {"oracle", PlannerMode::Oracle}};
   PerceptionMode perception = PerceptionMode::GroundTruth;

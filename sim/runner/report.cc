@@ -90,7 +90,7 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
       << " refused odometry messages, " << r.slam.loop_closures << " loop closures; update "
       << fixed(r.slam.update_ms_mean, 2) << " ms mean, " << fixed(r.slam.update_ms_p99, 2) << " ms p99\n";
   }
-  if (s.autonomy.slam == stack::SlamMode::Lio) {
+  if (s.autonomy.slam == stack::SlamMode::Lio || s.autonomy.slam == stack::SlamMode::LioGraph) {
     o << "              lio: " << r.slam.lio_slices << " slices, " << r.slam.lio_degenerate_slices
       << " with a pose direction unobserved, " << r.slam.lio_too_few_points << " with too few planes\n";
   }

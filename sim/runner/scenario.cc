@@ -193,8 +193,9 @@ std::string as_section_key(const std::string& problem) {
 }  // namespace
 
 std::string Scenario::check() const {
-  if (autonomy.slam == stack::SlamMode::Lio && autonomy.perception == stack::PerceptionMode::GroundTruth)
-    return "autonomy.slam = lio needs the LiDAR's scans: autonomy.perception = lidar or lidar_camera";
+  if ((autonomy.slam == stack::SlamMode::Lio || autonomy.slam == stack::SlamMode::LioGraph) &&
+      autonomy.perception == stack::PerceptionMode::GroundTruth)
+    return "autonomy.slam = lio or lio_graph needs the LiDAR's scans: autonomy.perception = lidar or lidar_camera";
   const double limit = vehicle::stable_step_limit(vehicle);
   if (1.0 / sim.physics_rate <= limit) return "";
   return "sim.physics_rate must be at least " + std::to_string(static_cast<int>(std::ceil(1.0 / limit))) +

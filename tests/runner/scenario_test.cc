@@ -186,7 +186,7 @@ TEST(Scenario, TheStableStepLimitIsTheCarsFastestMode) {
 
 TEST_F(ScenarioFile, LioWithoutTheLidarSaysWhatItNeeds) {
   EXPECT_THAT(error_of(write(std::string(kHead) + "[autonomy]\nperception = ground_truth\nslam = lio\n")),
-              HasSubstr(".ini: [autonomy] slam = lio needs the LiDAR's scans: autonomy.perception = lidar or lidar_camera"));
+              HasSubstr(".ini: [autonomy] slam = lio or lio_graph needs the LiDAR's scans: autonomy.perception = lidar or lidar_camera"));
 }
 
 TEST_F(ScenarioFile, AnOldKeyNamesItsNewPlace) {

@@ -241,6 +241,13 @@ TEST(Simulation, WithTheLioTheCarLocalisesOnTheRawScans) {
   const RunResult again = run(lio, s.track);
   ASSERT_EQ(again.log.size(), r.log.size());
   EXPECT_EQ(again.log.back().x, r.log.back().x);
+  // lio_graph: FastSLAM and the graph on the LIO's odometry (no closure in 6 s)
+  lio.autonomy.slam = stack::SlamMode::LioGraph;
+  const RunResult g = run(lio, s.track);
+  EXPECT_GT(g.slam.frames, 40);
+  EXPECT_LT(g.slam.ate_rms, 0.1);
+  EXPECT_GE(g.slam.map.precision, 0.95);
+  EXPECT_EQ(g.fallbacks, 0);
 }
 
 TEST(Simulation, WithTheGraphTheLoopClosesAndTheMapImproves) {
