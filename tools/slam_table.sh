@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # what each localisation buys on a scenario (the README's SLAM table, like
 # the paper's Tables I and II): dead reckoning, FastSLAM 1.0, FastSLAM 2.0,
-# FastSLAM 2.0 with the pose graph, each a full run of the scenario.
+# FastSLAM 2.0 with the pose graph, the LiDAR-inertial odometry alone and
+# under the graph, each a full run of the scenario.
 #   tools/slam_table.sh [SCENARIO.ini] [--set section.key=value]...
 # Prints a Markdown table. Runs ./paddock (which builds first).
 set -euo pipefail
@@ -34,5 +35,7 @@ odometry (dead reckoning)|--set autonomy.slam=odometry
 FastSLAM 1.0|--set autonomy.slam=fastslam --set slam.fastslam_version=1
 FastSLAM 2.0|--set autonomy.slam=fastslam --set slam.fastslam_version=2
 FastSLAM 2.0 + pose graph|--set autonomy.slam=fastslam_graph
+LIO|--set autonomy.slam=lio
+LIO + FastSLAM 2.0 + pose graph|--set autonomy.slam=lio_graph
 ground truth (reference)|--set autonomy.slam=ground_truth
 RUNS
