@@ -360,16 +360,21 @@ LioStatus Lio::update(const std::vector<Vector3d>& points) {
   Eigen::Matrix<double, 6, 6> info = Eigen::Matrix<double, 6, 6>::Zero();
   int matches = 0;
   bool converged = false;
+  planes_.resize(points.size());
+  bool search = true;
   for (int it = 0; it < pr.max_iterations && !converged; ++it) {
-    // the planes and residuals at this iterate
+    // the planes (searched again unless the last step moved the points less
+    // than a tenth of the map's leaf) and the residuals at this iterate
     Eigen::Matrix<double, 6, 6> HtH = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> Htz = Eigen::Matrix<double, 6, 1>::Zero();
     matches = 0;
-    for (const Vector3d& q : points) {
-      const Vector3d pw = x_.R * q + x_.p;
-      Vector3d n;
-      double d = 0.0;
-      if (!fit_plane(pw, n, d)) continue;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const Vector3d& q = points[i];
+      Plane& pl = planes_[i];
+      if (search) pl.valid = fit_plane(x_.R * q + x_.p, pl.n, pl.d);
+      if (!pl.valid) continue;
+      const Vector3d& n = pl.n;
+      const double d = pl.d;
       Eigen::Matrix<double, 1, 6> H;
       const double z = plane_residual(x_, q, n, d, &H);
       HtH += H.transpose() * H;
@@ -394,6 +399,9 @@ LioStatus Lio::update(const std::vector<Vector3d>& points) {
     const LioVector step = A_ldlt.solve(rhs) - dx_prior;
     x_ = boxplus(x_, step);
     ++generation_;
+    // a point at the slice's reach moves by |dp| + r |dtheta|
+    search = step.segment<3>(kLioP).norm() + pr.max_range * step.segment<3>(kLioTheta).norm() >
+             0.1 * pr.map.leaf_size;
     ++stats_.iterations;
     converged = step.norm() < pr.convergence;
     HtH_last.setZero();

@@ -39,7 +39,8 @@
 //   K = (H^T H / s^2 + P^-1)^-1 H^T / s^2
 //   x_j+1 = x_j [+] (-K z - (I - K H) dx_j)
 // until the step is below `convergence` or max_iterations; then
-// P = (I - K H) P. The neighbours are searched again at each iterate.
+// P = (I - K H) P. The neighbours are searched again at each iterate that
+// follows a step moving the points more than a tenth of the map's leaf.
 //
 // Degeneracy: the information the slice's planes give about the pose,
 // H^T H over (dtheta, dp) normalised by the points, is checked by its
@@ -277,6 +278,12 @@ class Lio {
   TimeNs front_t_ = 0;
   // scratch
   std::vector<VoxelMap::Neighbour> nn_;
+  struct Plane {
+    Eigen::Vector3d n;
+    double d = 0.0;
+    bool valid = false;
+  };
+  std::vector<Plane> planes_;  // update's, per point
 };
 
 }  // namespace paddock::slam
