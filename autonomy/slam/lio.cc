@@ -143,11 +143,10 @@ Isometry3d planar(const Pose2& p) {
 
 Lio::Lio(const LioParams& params, const LioExtrinsics& extrinsics, const Pose2& start)
     : params_(params::require_valid(params, "LioParams")),
-      ext_(extrinsics),
       imu_lidar_(extrinsics.base_imu.inverse() * extrinsics.base_lidar),
       imu_base_(extrinsics.base_imu.inverse()),
       map_(params.map) {
-  const Isometry3d world_imu = planar(start) * ext_.base_imu;
+  const Isometry3d world_imu = planar(start) * extrinsics.base_imu;
   x_.R = world_imu.linear();
   x_.p = world_imu.translation();
   const LioParams& p = params_;
@@ -263,13 +262,6 @@ void Lio::propagate(LioState& x, LioMatrix* P, TimeNs& now, TimeNs t, std::vecto
   push(now, Vector3d::Zero(), Vector3d::Zero());  // the end: only tau = 0 is read here
 }
 
-LioState Lio::predict(TimeNs t) const {
-  LioState x = x_;
-  TimeNs at = t_;
-  if (t > at) propagate(x, nullptr, at, t, nullptr);
-  return x;
-}
-
 Pose2 Lio::predict_base_pose(TimeNs t) {
   // carried on from the last prediction while the state is unchanged (the
   // IMU rate calls this once per sample: one interval each, not all since
@@ -356,7 +348,6 @@ LioStatus Lio::update(const std::vector<Vector3d>& points) {
   const Eigen::LLT<LioMatrix> P_llt(P_);
   if (P_llt.info() != Eigen::Success) return LioStatus::TooFewPoints;
   const LioMatrix P_inv = P_llt.solve(LioMatrix::Identity());
-  LioMatrix HtH_last = LioMatrix::Zero();
   Eigen::Matrix<double, 6, 6> info = Eigen::Matrix<double, 6, 6>::Zero();
   int matches = 0;
   bool converged = false;
@@ -404,11 +395,10 @@ LioStatus Lio::update(const std::vector<Vector3d>& points) {
              0.1 * pr.map.leaf_size;
     ++stats_.iterations;
     converged = step.norm() < pr.convergence;
-    HtH_last.setZero();
-    HtH_last.block<6, 6>(0, 0) = HtH * inv_s2;
   }
   // P = (I - K H) P = (H^T H / s^2 + P^-1)^-1
-  LioMatrix A = P_inv + HtH_last;
+  LioMatrix A = P_inv;
+  A.block<6, 6>(0, 0) += info * inv_s2;
   P_ = A.ldlt().solve(LioMatrix::Identity());
   P_ = 0.5 * (P_ + P_.transpose());
   // the pose's information per plane: its least eigenvalue (rotation in
@@ -455,12 +445,12 @@ LioStatus Lio::on_scan(const hal::LidarScan& scan) {
     const TimeNs t2 = usable[end - 1].t;
     knots.clear();
     propagate_to(std::max(t2, t_), &knots);
-    const std::vector<hal::LidarPoint> slice(usable.begin() + static_cast<std::ptrdiff_t>(begin),
-                                             usable.begin() + static_cast<std::ptrdiff_t>(end));
-    std::vector<Vector3d> pts = deskew(slice, imu_lidar_, knots);
+    slice_.assign(usable.begin() + static_cast<std::ptrdiff_t>(begin), usable.begin() + static_cast<std::ptrdiff_t>(end));
+    std::vector<Vector3d> pts = deskew(slice_, imu_lidar_, knots);
     // one point a leaf (the first of it, in time order)
     if (pr.scan_leaf > 0.0) {
-      std::unordered_set<std::uint64_t> seen;
+      std::unordered_set<std::uint64_t>& seen = leaf_seen_;
+      seen.clear();
       std::vector<Vector3d> kept;
       for (const Vector3d& q : pts) {
         const auto cell = [&](double c) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(c / pr.scan_leaf)) & 0x1fffff); };

@@ -70,6 +70,7 @@
 #include <cstdint>
 #include <deque>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 #include <Eigen/Core>
@@ -208,17 +209,16 @@ class Lio {
   // own time); returns the status of its last slice
   LioStatus on_scan(const hal::LidarScan& scan);
 
-  // the IMU-frame state as of the last slice (or the last IMU sample
-  // propagated to: state_at)
+  // the IMU-frame state at stamp(): the last slice's end, or the time
+  // propagate_to reached
   const LioState& state() const { return x_; }
   const LioMatrix& covariance() const { return P_; }
   TimeNs stamp() const { return t_; }
   // the base's planar pose and its covariance (x, y, yaw) at the state's time
   Pose2 base_pose() const;
   Eigen::Matrix3d base_pose_covariance() const;
-  // the state propagated on the buffered IMU samples to `t` (not kept; no
-  // covariance), and the base's planar pose then
-  LioState predict(TimeNs t) const;
+  // the base's planar pose at `t`: the state propagated on the buffered IMU
+  // samples (not kept; no covariance)
   Pose2 predict_base_pose(TimeNs t);
   // the state set to x at time t (the covariance kept): a re-anchoring, or a
   // start that is not at rest
@@ -260,7 +260,6 @@ class Lio {
   void initialise_from_rest(TimeNs t);
 
   LioParams params_;
-  LioExtrinsics ext_;
   Eigen::Isometry3d imu_lidar_;
   Eigen::Isometry3d imu_base_;
   LioState x_;
@@ -284,6 +283,8 @@ class Lio {
     bool valid = false;
   };
   std::vector<Plane> planes_;  // update's, per point
+  std::vector<hal::LidarPoint> slice_;        // on_scan's current slice
+  std::unordered_set<std::uint64_t> leaf_seen_;  // its down-sampling's leaves
 };
 
 }  // namespace paddock::slam
