@@ -345,6 +345,7 @@ LioStatus Lio::update(const std::vector<Vector3d>& points) {
   const LioParams& pr = params_;
   const LioState prior = x_;
   const double inv_s2 = 1.0 / (pr.point_std * pr.point_std);
+  const double huber = pr.huber_k * pr.point_std;
   const Eigen::LLT<LioMatrix> P_llt(P_);
   if (P_llt.info() != Eigen::Success) return LioStatus::TooFewPoints;
   const LioMatrix P_inv = P_llt.solve(LioMatrix::Identity());
@@ -368,8 +369,10 @@ LioStatus Lio::update(const std::vector<Vector3d>& points) {
       const double d = pl.d;
       Eigen::Matrix<double, 1, 6> H;
       const double z = plane_residual(x_, q, n, d, &H);
-      HtH += H.transpose() * H;
-      Htz += H.transpose() * z;
+      // Huber's weight at this iterate (iteratively reweighted)
+      const double w = huber > 0.0 && std::abs(z) > huber ? huber / std::abs(z) : 1.0;
+      HtH += w * H.transpose() * H;
+      Htz += w * H.transpose() * z;
       ++matches;
     }
     stats_.last_matches = matches;

@@ -41,6 +41,14 @@
 // until the step is below `convergence` or max_iterations; then
 // P = (I - K H) P. The neighbours are searched again at each iterate that
 // follows a step moving the points more than a tenth of the map's leaf.
+// Each residual is weighted by Huber's loss at the iterate (w = 1 up to
+// huber_k s, huber_k s / |z| beyond: iteratively reweighted, H^T W H and
+// H^T W z in place of H^T H and H^T z). Five neighbours within a metre can
+// span two surfaces (three ground points and two on a barrier's foot lie on
+// one tilted plane, 9 cm from a ground point beside them) and pull the
+// state with them: driving a 20 m circle between two rings of blocks from
+// exact data (tests/slam/lio_test.cc), the worst error over 300 m is 0.19 m
+// by least squares and 0.06 m with Huber at 1.5 s.
 //
 // Degeneracy: the information the slice's planes give about the pose,
 // H^T H over (dtheta, dp) normalised by the points, is checked by its
@@ -104,6 +112,10 @@ struct LioParams {
 
   // the LiDAR side
   double point_std = 0.03;            // m, a point-to-plane residual's noise
+  // the residuals' robust loss: Huber's, quadratic up to huber_k point_std
+  // and linear beyond (a residual that is no plane's, such as a plane fitted
+  // across a corner, pulls with a bounded force); 0: plain least squares
+  double huber_k = 1.5;
   double min_range = 1.0;             // m, nearer points are dropped (the car)
   double max_range = 40.0;            // m
   double scan_leaf = 0.2;             // m, the slice's down-sampling (one point a leaf)
@@ -132,6 +144,7 @@ struct LioParams {
     v(PADDOCK_PARAM(initial_yaw_std), {"rad", params::above_up_to(0.0, 10.0), "initial yaw std"});
     v(PADDOCK_PARAM(init_time), {"s", params::in(0.0, 60.0), "standstill averaged for the gyro bias before the first scan"});
     v(PADDOCK_PARAM(point_std), {"m", params::above_up_to(0.0, 10.0), "point-to-plane residual std"});
+    v(PADDOCK_PARAM(huber_k), {"", params::in(0.0, 100.0), "Huber loss threshold in point_std (0: least squares)"});
     v(PADDOCK_PARAM(min_range), {"m", params::in(0.0, 100.0), "nearer points are dropped"});
     v(PADDOCK_PARAM(max_range), {"m", params::above_up_to(0.0, 1000.0), "farther points are dropped"});
     v(PADDOCK_PARAM(scan_leaf), {"m", params::in(0.0, 10.0), "down-sampling leaf of a slice (0: none)"});

@@ -312,6 +312,56 @@ TEST(Lio, AFlatGroundAloneIsReportedDegenerate) {
   EXPECT_NEAR(lio.state().p.z(), 0.3, 0.01);
 }
 
+// driving the 20 m circle at 10 m/s for 30 s (300 m) between two rings of
+// barrier blocks (1 m cubes, at 15 and 25 m from the circle's centre), from
+// the exact IMU samples and noise-free scans: the odometry (no prior map, no
+// loop closure) must stay within a few centimetres of the truth. Measured
+// (16 rings, 720 columns): 0.056 m and 1.1 mrad at worst with Huber's loss;
+// 0.19 m and 8 mrad by plain least squares, whose planes fitted across a
+// block's foot (ground and face points on one tilted plane) pull the state
+TEST(Lio, DrivesACircleBetweenBarrierRingsWithoutDrift) {
+  std::vector<Box> boxes;
+  for (const double ring : {15.0, 25.0}) {
+    const int n = static_cast<int>(2.0 * kPi * ring / 2.5);
+    for (int k = 0; k < n; ++k) {
+      const double a = 2.0 * kPi * k / n;
+      const Vector3d c(ring * std::sin(a), kRadius - ring * std::cos(a), 0.0);
+      // axis-aligned blocks (the slab caster's): about 1 m square, 1 m high
+      boxes.push_back({c + Vector3d(-0.5, -0.5, 0.0), c + Vector3d(0.5, 0.5, 1.0)});
+    }
+  }
+  LioParams p = test_params();
+  Lio lio(p, extrinsics(), Pose2{});
+  const double T = 30.0;
+  const int n_imu = static_cast<int>((T + 0.5) * kImuRate);
+  for (int k = 0; k <= n_imu; ++k) lio.on_imu(circle_imu(k / kImuRate));
+  lio.reset(circle_state(0.0), 0);
+  double worst = 0.0, worst_yaw = 0.0;
+  const int scans = static_cast<int>(T / kPeriod);
+  for (int s = 0; s < scans; ++s) {
+    lio.on_scan(scan_of(boxes, true, s * kPeriod, circle_pose));
+    const Isometry3d truth = circle_pose(to_seconds(lio.stamp()));
+    worst = std::max(worst, (lio.state().p - truth.translation()).norm());
+    worst_yaw = std::max(worst_yaw, std::abs(so3_log(truth.linear().transpose() * lio.state().R).z()));
+  }
+  std::printf("circle between barrier rings, %d scans (%.0f m): worst %.4f m, %.5f rad; %ld of %ld slices degenerate\n",
+              scans, kSpeed * T, worst, worst_yaw, lio.stats().degenerate_slices, lio.stats().slices);
+  EXPECT_LT(worst, 0.08);
+  EXPECT_LT(worst_yaw, 0.003);
+  // and plain least squares does worse here (the loss is what holds it)
+  p.huber_k = 0.0;
+  Lio plain(p, extrinsics(), Pose2{});
+  for (int k = 0; k <= n_imu; ++k) plain.on_imu(circle_imu(k / kImuRate));
+  plain.reset(circle_state(0.0), 0);
+  double plain_worst = 0.0;
+  for (int s = 0; s < scans; ++s) {
+    plain.on_scan(scan_of(boxes, true, s * kPeriod, circle_pose));
+    plain_worst = std::max(plain_worst, (plain.state().p - circle_pose(to_seconds(plain.stamp())).translation()).norm());
+  }
+  std::printf("the same by least squares: worst %.4f m\n", plain_worst);
+  EXPECT_GT(plain_worst, 2.0 * worst);
+}
+
 TEST(Lio, BadSamplesAndPointsAreCountedAndIgnored) {
   const std::vector<Box> boxes = yard();
   const auto still = [](double) { return Isometry3d::Identity(); };
