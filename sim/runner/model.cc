@@ -41,6 +41,7 @@ SimModel compile_model(const Scenario& scenario, const world::TrackModel& track)
   m.scenario = scenario;
   m.track = track;
   m.cones = event_cones(track);
+  m.blocks = world::venue_blocks(track, m.cones, scenario.venue);
   m.footprint = vehicle::footprint(scenario.vehicle);
   m.start = start_pose(track, m.footprint.x_max);
   m.stack = stack_params(scenario);

@@ -14,6 +14,7 @@
 #include "sim/sensors/cone_sensor.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/track.h"
+#include "sim/world/venue.h"
 
 namespace paddock::runner {
 
@@ -31,6 +32,7 @@ struct SimModel {
   Scenario scenario;           // as loaded: every module's and sensor's parameters
   world::TrackModel track;     // the event's track (the event's on-track test points into it)
   std::vector<Cone> cones;     // the cones standing at the event (event_cones)
+  std::vector<world::Block> blocks;  // the venue's barrier blocks ([venue]; the sensors see them)
   Pose2 start;                 // the car's base pose at the start (start_pose)
   vehicle::Footprint footprint;
   stack::StackParams stack;    // the stack's parameters (stack_params)

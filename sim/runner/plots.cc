@@ -14,6 +14,7 @@
 #include "sim/runner/scenario.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/track.h"
+#include "sim/world/venue.h"
 
 namespace paddock::runner {
 namespace {
@@ -324,6 +325,23 @@ std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) 
     map.speed.push_back(std::hypot(r.vx, r.vy));
   }
 
+  // the venue's barrier blocks ([venue]), outlined
+  const std::vector<world::Block> blocks = world::venue_blocks(track, map.cones, scenario.venue);
+  if (!blocks.empty()) {
+    render::MapLayer layer;
+    layer.kind = render::MapLayer::Kind::Segments;
+    layer.label = "barrier";
+    layer.color = {90, 90, 90, 255};
+    layer.size = 1.0;
+    for (const world::Block& b : blocks) {
+      const std::vector<Vec2> c = world::block_corners(b);
+      for (std::size_t k = 0; k < c.size(); ++k) {
+        layer.points.push_back(c[k]);
+        layer.points.push_back(c[(k + 1) % c.size()]);
+      }
+    }
+    map.layers.push_back(std::move(layer));
+  }
   add_plan_layers(dir + "/plan.json", map);
 
   // the controller data over the whole run, laps marked

@@ -18,9 +18,10 @@ std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t 
 }
 
 RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
-                       const std::optional<sensors::CameraParams>& camera, const sensors::DetectorParams& detector,
-                       std::uint64_t lidar_seed, std::uint64_t camera_seed, std::uint64_t detector_seed)
-    : lidar_(lidar, lidar_seed), ground_(ground) {
+                       const std::vector<world::Block>& blocks, const std::optional<sensors::CameraParams>& camera,
+                       const sensors::DetectorParams& detector, std::uint64_t lidar_seed, std::uint64_t camera_seed,
+                       std::uint64_t detector_seed)
+    : lidar_(lidar, lidar_seed), ground_(ground), blocks_(blocks) {
   if (!camera) return;
   camera_ = std::make_unique<sensors::Camera>(*camera, camera_seed);
   detector_ = std::make_unique<sensors::AnnotationDetector>(detector, detector_seed);
@@ -70,7 +71,7 @@ void RawSensors::update_scene(const world::ConeWorld& cones) {
     scene_knocked_[i] = cones.cone_knocked(ii);
   }
   world_.reset();  // one Embree device at a time
-  world_ = std::make_unique<sensors::LidarWorld>(scene_cones_, scene_knocked_, ground_);
+  world_ = std::make_unique<sensors::LidarWorld>(scene_cones_, scene_knocked_, ground_, blocks_);
 }
 
 const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,

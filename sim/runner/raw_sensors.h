@@ -26,6 +26,7 @@
 #include "sim/sensors/camera.h"
 #include "sim/sensors/lidar.h"
 #include "sim/world/cone_world.h"
+#include "sim/world/venue.h"
 
 namespace paddock::runner {
 
@@ -51,7 +52,7 @@ class RawSensors {
   // none; detector: the error model of its detector node. The LiDAR, the
   // camera and the detector each draw from their own random stream
   RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
-             const std::optional<sensors::CameraParams>& camera, const sensors::DetectorParams& detector,
+             const std::vector<world::Block>& blocks, const std::optional<sensors::CameraParams>& camera, const sensors::DetectorParams& detector,
              std::uint64_t lidar_seed, std::uint64_t camera_seed, std::uint64_t detector_seed);
 
   // true when a rotation ends at `now` (one starts at 0, then every period)
@@ -60,7 +61,8 @@ class RawSensors {
   // each column from its pose in `poses` (which must cover the rotation), and
   // posts the detections of the camera frame it triggered (exposed at the
   // trigger column's time, from the pose of that instant), then the scan;
-  // returns its ground truth: per point the cone index hit (-1 the ground), in
+  // returns its ground truth: per point the cone index hit (sensors::kHitGround
+  // the ground, kHitStructure a barrier block), in
   // the order of the scan's points
   const std::vector<std::int32_t>& emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,
                                         SimHal& hal);
@@ -78,6 +80,7 @@ class RawSensors {
   hal::CameraFrame frame_;
   sensors::CameraAnnotation annotation_;
   sensors::GroundParams ground_;
+  std::vector<world::Block> blocks_;
   std::unique_ptr<sensors::LidarWorld> world_;
   std::vector<Cone> scene_cones_;
   std::vector<bool> scene_knocked_;

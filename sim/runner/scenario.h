@@ -19,6 +19,7 @@
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
 #include "sim/world/track.h"
+#include "sim/world/venue.h"
 #include "autonomy/common/params.h"
 #include "sim/runner/schema.h"
 
@@ -112,6 +113,7 @@ struct Scenario {
   vehicle::VehicleParams vehicle;
   world::ConeWorldParams cones;
   sensors::GroundParams ground;
+  world::VenueParams venue;
   events::EventParams event;
   // the sensors
   sensors::ConeSensorParams cone_sensor;
@@ -142,6 +144,7 @@ struct Scenario {
     v.section(PADDOCK_PARAM(vehicle), "every physical parameter of the car, all required: include = vehicles/default.ini");
     v.section(PADDOCK_PARAM(cones), "the cones' physics (Box2D): masses, knock-over impulses, frictions");
     v.section(PADDOCK_PARAM(ground), "the ground the sensors see (the vehicle model stays planar)");
+    v.section(PADDOCK_PARAM(venue), "what stands around the track besides the cones: barrier rows the sensors see");
     v.section(PADDOCK_PARAM(event), "the event's limits: timeout, stop, off-track and stall times");
     v.section(PADDOCK_PARAM(cone_sensor), "the object-level cone sensor of perception = ground_truth");
     v.section(PADDOCK_PARAM(lidar), "the rotating LiDAR of perception = lidar | lidar_camera");

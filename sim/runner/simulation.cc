@@ -130,8 +130,8 @@ std::unique_ptr<RawSensors> make_raw_sensors(const SimModel& model) {
   if (!model.raw_perception) return nullptr;
   const Scenario& scenario = model.scenario;
   const std::uint64_t seed = scenario.scenario.seed;
-  return std::make_unique<RawSensors>(scenario.lidar, scenario.ground, model.camera, scenario.detector, stream_seed(seed, "lidar"),
-                                      stream_seed(seed, "camera"), stream_seed(seed, "detector"));
+  return std::make_unique<RawSensors>(scenario.lidar, scenario.ground, model.blocks, model.camera, scenario.detector,
+                                      stream_seed(seed, "lidar"), stream_seed(seed, "camera"), stream_seed(seed, "detector"));
 }
 
 // what the run leaves behind besides the observers' records: the event's

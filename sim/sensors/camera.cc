@@ -26,6 +26,7 @@ const Rgb& albedo(const CameraParams& p, LidarMaterial m) {
     case LidarMaterial::Black: return p.black;
     case LidarMaterial::Grey: return p.grey;
     case LidarMaterial::Ground: return p.ground;
+    case LidarMaterial::Barrier: return p.grey;  // grey concrete, as a cone of no colour
   }
   return p.grey;
 }
@@ -364,9 +365,13 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
     }
     cast(tiles_, [&](std::uint32_t p, const RTCRayHit16& rh, int k) {
       const std::int32_t cone = world.cone_of(rh.hit.geomID[k], rh.hit.primID[k]);
-      if (cone < -1) return;
+      if (cone == kHitNothing) return;
       double lambert = 0.0;
-      if (cone == -1) {
+      const Rgb* colour = &params_.ground;
+      if (cone == kHitStructure) {
+        colour = &albedo(params_, LidarMaterial::Barrier);
+        lambert = lambert_of(rh, k);
+      } else if (cone == kHitGround) {
         lambert = lambert_of(rh, k);
       } else {
         const double t = rh.ray.tfar[k];
@@ -376,7 +381,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
         const double gy = (world.ground_z(x, y + e) - world.ground_z(x, y - e)) / (2.0 * e);
         lambert = std::max(0.0, (-gx * sun_[0] - gy * sun_[1] + sun_[2]) / std::sqrt(gx * gx + gy * gy + 1.0));
       }
-      const std::array<std::uint8_t, 3> rgb = shade(params_.ground, lambert);
+      const std::array<std::uint8_t, 3> rgb = shade(*colour, lambert);
       const int i = static_cast<int>(p % static_cast<std::uint32_t>(W));
       const int j = static_cast<int>(p / static_cast<std::uint32_t>(W));
       const int i0 = i - kGroundTile / 2, j0 = j - kGroundTile / 2;
@@ -395,9 +400,14 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   carry_t_.clear();
   cast(cast_, [&](std::uint32_t p, const RTCRayHit16& rh, int k) {
     const std::int32_t cone = world.cone_of(rh.hit.geomID[k], rh.hit.primID[k]);
-    if (cone < -1) return;
-    if (cone == -1 && flat_ground) return;  // the analytic ground is the same
+    if (cone == kHitNothing) return;
+    if (cone == kHitGround && flat_ground) return;  // the analytic ground is the same
     const double t = rh.ray.tfar[k];
+    if (cone == kHitStructure) {  // a barrier block: opaque, nothing behind it counts
+      const std::array<std::uint8_t, 3> rgb = shade(albedo(params_, LidarMaterial::Barrier), lambert_of(rh, k));
+      std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
+      return;
+    }
     const LidarMaterial m =
         cone < 0 ? LidarMaterial::Ground
                  : world.material_of(rh.hit.geomID[k], rh.hit.primID[k], o[0] + t * rh.ray.dir_x[k],
@@ -436,7 +446,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
       ++last_continued_rays_;
       if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) break;
       const std::int32_t cone = world.cone_of(rh.hit.geomID, rh.hit.primID);
-      if (cone < -1) break;
+      if (cone == kHitNothing || cone == kHitStructure) break;  // a block is opaque
       tnear = rh.ray.tfar;
       if (cone == -1) {
         if (flat_ground) break;  // below the plane from here on

@@ -50,6 +50,11 @@
 // exact). That costs W H / 16 more rays on a large grid: about 5 ms a frame at
 // 800 x 500 (FSG 2023, 0.1 m bumps).
 //
+// The venue's barrier blocks are opaque and grey (the unknown cone's albedo):
+// where a ray meets one first, the cones behind it are hidden. They are drawn
+// only where rays are cast (in the cones' boxes; on non-flat ground also the
+// ground tiles'): elsewhere the image shows the analytic ground and sky.
+//
 // Annotation (CameraAnnotation). labels[p] = LidarWorld::cone_of of the first hit, -1 for ground
 // and sky. One CameraInstance per cone with >= 1 labelled pixel, in ascending
 // cone index: id = the cone index, color = its colour class (from the scene:

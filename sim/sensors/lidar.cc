@@ -37,6 +37,8 @@ void check(RTCDevice device, const char* what) {
 
 constexpr int kConeVertices = 2 * kConeSegments + 1;  // base ring, top ring, top centre
 constexpr int kConeTriangles = 3 * kConeSegments;     // lateral quads (2 each), top fan
+constexpr int kBlockVertices = 8;                      // the footprint's corners at the base, then at the top
+constexpr int kBlockTriangles = 10;                    // four sides (2 each), the top
 
 // Embree's reciprocal 1 / a as its kernels take it (common/simd/vfloat{4,8,16}_*.h,
 // Embree 3.13): an estimate r refined by one Newton step r + r (1 - a r). Which
@@ -187,6 +189,7 @@ double reflectivity(const LidarParams& p, LidarMaterial m) {
     case LidarMaterial::Black: return p.reflect_black;
     case LidarMaterial::Grey: return p.reflect_grey;
     case LidarMaterial::Ground: return p.reflect_ground;
+    case LidarMaterial::Barrier: return p.reflect_barrier;
   }
   return 0.0;
 }
@@ -223,7 +226,7 @@ GroundShape ground_shape(const GroundParams& g, double x, double y) {
 // ---------------------------------------------------------------- LidarWorld
 
 LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked,
-                       const GroundParams& ground)
+                       const GroundParams& ground, const std::vector<world::Block>& blocks)
     : ground_(ground) {
   if (!knocked.empty() && knocked.size() != cones.size()) {
     throw std::invalid_argument("LidarWorld: knocked must be empty or of the size of cones");
@@ -258,6 +261,24 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
       cone_of_mesh_.push_back(static_cast<std::int32_t>(i));
     }
     cone_count_ = cones.size();
+    // the blocks with a finite footprint grow the box too
+    std::vector<const world::Block*> solid;
+    for (const world::Block& b : blocks) {
+      if (!finite(b.centre) || !finite(b.yaw) || !(b.length > 0.0) || !(b.width > 0.0) || !(b.height > 0.0)) continue;
+      solid.push_back(&b);
+      for (const Vec2 q : world::block_corners(b)) {
+        if (!any) {
+          lo_x = hi_x = q.x;
+          lo_y = hi_y = q.y;
+          any = true;
+        }
+        lo_x = std::min(lo_x, q.x);
+        hi_x = std::max(hi_x, q.x);
+        lo_y = std::min(lo_y, q.y);
+        hi_y = std::max(hi_y, q.y);
+      }
+    }
+    block_count_ = solid.size();
 
     // ground: two triangles at z = 0 when flat, else a height-field grid
     if (flat(ground_)) {
@@ -417,6 +438,70 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
       check(device_, "cone geometry");
     }
 
+    // blocks: one triangle mesh, kBlockTriangles per block (its four sides
+    // and its top; the base stands on the ground), in `solid` order
+    if (!solid.empty()) {
+      const std::size_t n = solid.size();
+      RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+      check(device_, "rtcNewGeometry(blocks)");
+      auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), n * kBlockVertices));
+      auto* idx = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n * kBlockTriangles));
+      check(device_, "rtcSetNewGeometryBuffer(blocks)");
+      for (std::size_t k = 0; k < n; ++k) {
+        const world::Block& blk = *solid[k];
+        const std::vector<Vec2> corners = world::block_corners(blk);
+        // the base at the lowest ground under the corners (on a slope the
+        // block's uphill foot sinks into the ground: it stands level)
+        double z0 = std::numeric_limits<double>::infinity(), z1 = -z0;
+        for (const Vec2 q : corners) {
+          z0 = std::min(z0, ground_height(ground_, q.x, q.y));
+          z1 = std::max(z1, ground_height(ground_, q.x, q.y));
+        }
+        const double top = z1 + blk.height;
+        float* vk = v + 3 * kBlockVertices * k;
+        for (int q = 0; q < 4; ++q) {
+          const Vec2 c = corners[static_cast<std::size_t>(q)];
+          float* lo = vk + 3 * q;
+          float* hi = vk + 3 * (4 + q);
+          lo[0] = hi[0] = static_cast<float>(c.x);
+          lo[1] = hi[1] = static_cast<float>(c.y);
+          lo[2] = static_cast<float>(z0);
+          hi[2] = static_cast<float>(top);
+        }
+        double lo[3] = {vk[0], vk[1], vk[2]}, hi[3] = {vk[0], vk[1], vk[2]};
+        for (int q = 1; q < kBlockVertices; ++q) {
+          for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], static_cast<double>(vk[3 * q + a]));
+            hi[a] = std::max(hi[a], static_cast<double>(vk[3 * q + a]));
+          }
+        }
+        Bounds b{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]),
+                 0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]), 0.5 * (hi[2] - lo[2]), 0.0};
+        for (int q = 0; q < kBlockVertices; ++q) {
+          const double dx = vk[3 * q] - b.x, dy = vk[3 * q + 1] - b.y, dz = vk[3 * q + 2] - b.z;
+          b.r = std::max(b.r, std::sqrt(dx * dx + dy * dy + dz * dz));
+        }
+        bounds_.push_back(b);
+        const auto base = static_cast<unsigned>(kBlockVertices * k);
+        unsigned* ik = idx + 3 * kBlockTriangles * k;
+        for (unsigned s = 0; s < 4; ++s) {
+          const unsigned s1 = (s + 1) % 4;
+          unsigned* q = ik + 6 * s;
+          q[0] = base + s; q[1] = base + s1; q[2] = base + 4 + s1;  // side, lower
+          q[3] = base + s; q[4] = base + 4 + s1; q[5] = base + 4 + s;  // side, upper
+        }
+        unsigned* t = ik + 24;
+        t[0] = base + 4; t[1] = base + 5; t[2] = base + 6;  // top
+        t[3] = base + 4; t[4] = base + 6; t[5] = base + 7;
+      }
+      rtcCommitGeometry(g);
+      block_geom_ = rtcAttachGeometry(scene_, g);
+      rtcReleaseGeometry(g);
+      check(device_, "block geometry");
+    }
+
     rtcCommitScene(scene_);
     check(device_, "rtcCommitScene");
     if (flat(ground_)) quad_rcp_ = probe_quad_rcp(scene_, quad_x0_, quad_y0_, quad_ng_);
@@ -433,17 +518,19 @@ LidarWorld::~LidarWorld() {
 }
 
 std::int32_t LidarWorld::cone_of(unsigned geom_id, unsigned prim_id) const {
-  if (geom_id == RTC_INVALID_GEOMETRY_ID) return -2;
-  if (geom_id == ground_geom_) return -1;
+  if (geom_id == RTC_INVALID_GEOMETRY_ID) return kHitNothing;
+  if (geom_id == ground_geom_) return kHitGround;
   if (geom_id == cone_geom_) {
     const std::size_t k = prim_id / static_cast<unsigned>(kConeTriangles);
     if (k < cone_of_mesh_.size()) return cone_of_mesh_[k];
   }
-  return -2;
+  if (geom_id == block_geom_) return kHitStructure;
+  return kHitNothing;
 }
 
 LidarMaterial LidarWorld::material_of(unsigned geom_id, unsigned prim_id, double x, double y,
                                       double z) const {
+  if (geom_id == block_geom_) return LidarMaterial::Barrier;
   if (geom_id == cone_geom_) {
     const std::size_t k = prim_id / static_cast<unsigned>(kConeTriangles);
     if (k < mesh_info_.size()) {
@@ -867,7 +954,7 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
     b.ok[j] = 0;
     if (h.geom == kNoGeom) return;
     const std::int32_t cone = world.cone_of(h.geom, h.prim);
-    if (cone < -1) return;
+    if (cone == kHitNothing) return;
     const auto cu = static_cast<std::size_t>(c);
     const ColumnPose& q = poses_[cu];
     double sensor[3];
@@ -876,8 +963,8 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
     const double r_true = static_cast<double>(h.t);  // |dir| = 1: tfar is the range
     const double dx = dir[0], dy = dir[1], dz = dir[2];
     const double rho =
-        cone < 0 ? rho_ground
-                 : reflectivity(params_, world.material_of(h.geom, h.prim, org[0] + r_true * dx,
+        cone == kHitGround ? rho_ground
+                           : reflectivity(params_, world.material_of(h.geom, h.prim, org[0] + r_true * dx,
                                                            org[1] + r_true * dy,
                                                            org[2] + r_true * dz));
     const double nx = h.ng[0], ny = h.ng[1], nz = h.ng[2];

@@ -1,7 +1,8 @@
 #pragma once
 // a rotating multi-channel LiDAR, ray-cast with Embree 3 against cone meshes of
 // their real size standing on the ground: a flat plane z = 0 or a height field
-// (GroundParams: a slope plus sinusoidal bumps).
+// (GroundParams: a slope plus sinusoidal bumps); and the venue's barrier
+// blocks (world::Block, boxes of their own material), when there are any.
 //
 // Model (LidarParams) + the scene (LidarWorld: the Embree device and scene,
 // built once from the cones) + a small class holding only its random stream
@@ -53,6 +54,7 @@
 #include "autonomy/common/geometry.h"
 #include "autonomy/common/time.h"
 #include "autonomy/hal/lidar_layout.h"
+#include "sim/world/venue.h"
 
 namespace paddock::sensors {
 
@@ -77,6 +79,7 @@ struct LidarParams : hal::LidarLayout {
   double reflect_black = 0.05;   // black stripe
   double reflect_grey = 0.4;     // cones of unknown colour: plain grey
   double reflect_ground = 0.15;  // asphalt
+  double reflect_barrier = 0.35;  // the venue's barrier blocks (grey concrete, white plastic ~0.5)
   double intensity_range_ref = 5.0;
   double intensity_noise = 0.01;
 
@@ -95,6 +98,7 @@ struct LidarParams : hal::LidarLayout {
     v(PADDOCK_PARAM(reflect_black), {"", params::fraction(), "reflectivity of the black stripes"});
     v(PADDOCK_PARAM(reflect_grey), {"", params::fraction(), "reflectivity of a cone of unknown colour"});
     v(PADDOCK_PARAM(reflect_ground), {"", params::fraction(), "reflectivity of the ground"});
+    v(PADDOCK_PARAM(reflect_barrier), {"", params::fraction(), "reflectivity of the venue's barrier blocks ([venue])"});
     v(PADDOCK_PARAM(intensity_range_ref), {"m", params::above(0.0), "the intensity falls off as min(1, (ref / r)^2)"});
     v(PADDOCK_PARAM(intensity_noise), {"", params::fraction(), "intensity noise std (before clamping to [0, 1])"});
   }
@@ -164,7 +168,13 @@ inline constexpr double kBigStripe1Hi = 0.42;
 inline constexpr double kBigStripe2Lo = 0.58;
 inline constexpr double kBigStripe2Hi = 0.72;
 
-enum class LidarMaterial { White, Yellow, Orange, Blue, Black, Grey, Ground };
+enum class LidarMaterial { White, Yellow, Orange, Blue, Black, Grey, Ground, Barrier };
+
+// what LidarWorld::cone_of (and LidarPoint::cone) gives for a hit that is
+// not a cone: the ground, nothing, a venue structure (a barrier block)
+inline constexpr std::int32_t kHitGround = -1;
+inline constexpr std::int32_t kHitNothing = -2;
+inline constexpr std::int32_t kHitStructure = -3;
 
 // the material of a cone of colour `color` at `height_fraction` (0 = base,
 // 1 = top) of its height: blue with a white middle stripe, yellow with a black
@@ -193,8 +203,9 @@ enum class LidarCast {
   Single,
 };
 
-// the static scene: cones (BigOrange big, every other colour small) and the
-// ground. Flat ground is one quad at z = 0 that extends kGroundMargin past the
+// the static scene: cones (BigOrange big, every other colour small), the
+// venue's barrier blocks (world::Block: boxes standing on the ground, their
+// base at the lowest ground under their footprint's corners) and the ground. Flat ground is one quad at z = 0 that extends kGroundMargin past the
 // cones' bounding box. Any other ground is a grid of right-triangle pairs over
 // the cones' bounding box plus kGridMargin, vertices on ground_height; its cell
 // is ground.cell, enlarged (if need be) so the grid has at most kMaxGridCells
@@ -229,14 +240,15 @@ class LidarWorld {
   // params::validate(ground) fails. Cones with a non-finite position are left out (and
   // are never reported as hit).
   explicit LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked = {},
-                      const GroundParams& ground = {});
+                      const GroundParams& ground = {}, const std::vector<world::Block>& blocks = {});
   ~LidarWorld();
   LidarWorld(const LidarWorld&) = delete;
   LidarWorld& operator=(const LidarWorld&) = delete;
 
-  // the whole scene: the ground and the cones
+  // the whole scene: the ground, the cones and the blocks
   RTCScene scene() const { return scene_; }
   std::size_t cone_count() const { return cone_count_; }
+  std::size_t block_count() const { return block_count_; }
   const GroundParams& ground() const { return ground_; }
   // ground_height(ground(), x, y)
   double ground_z(double x, double y) const { return ground_height(ground_, x, y); }
@@ -247,11 +259,12 @@ class LidarWorld {
   // of the candidates for Embree's reciprocal reproduced Embree's own hits on
   // probe rays when the world was built (lidar.cc)
   bool ground_closed_form() const { return quad_rcp_ != nullptr; }
-  // the cone index hit by (geomID, primID), -1 for the ground, -2 for nothing
+  // the cone index hit by (geomID, primID), kHitGround (-1) for the ground,
+  // kHitStructure (-3) for a block, kHitNothing (-2) for nothing
   std::int32_t cone_of(unsigned geom_id, unsigned prim_id) const;
   // the material at the hit (geomID, primID) at world point (x, y, z): the
-  // ground's, or the cone's stripe at the point's height along the cone's axis.
-  // Only meaningful when cone_of(geom_id, prim_id) >= -1.
+  // ground's, a block's, or the cone's stripe at the point's height along the
+  // cone's axis. Only meaningful when cone_of(geom_id, prim_id) != kHitNothing.
   LidarMaterial material_of(unsigned geom_id, unsigned prim_id, double x, double y,
                             double z) const;
 
@@ -259,11 +272,13 @@ class LidarWorld {
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
   std::size_t cone_count_ = 0;
+  std::size_t block_count_ = 0;
   GroundParams ground_;
   double ground_cell_ = 0.0;
   std::size_t ground_triangles_ = 0;
   unsigned ground_geom_ = RTC_INVALID_GEOMETRY_ID;
   unsigned cone_geom_ = RTC_INVALID_GEOMETRY_ID;
+  unsigned block_geom_ = RTC_INVALID_GEOMETRY_ID;
   std::vector<std::int32_t> cone_of_mesh_;  // mesh k (in the cone geometry) -> cone index
   // mesh k: colour, height, the base centre and the unit axis (base -> top)
   struct MeshInfo {
@@ -273,7 +288,8 @@ class LidarWorld {
     double ax, ay, az;
   };
   std::vector<MeshInfo> mesh_info_;
-  // LidarCast::Exploit. Mesh k's bounds, from the float vertices Embree holds
+  // LidarCast::Exploit. Mesh k's bounds (the cones' meshes, then the
+  // blocks'), from the float vertices Embree holds
   // (so every triangle lies inside): the box of its vertices (centre x, y, z,
   // half-extents ex, ey, ez) and the ball about the box's centre through its
   // farthest vertex (radius r)
@@ -301,7 +317,7 @@ struct LidarPoint {
   float intensity;      // -, [0, 1]; the material model (see the top)
   std::uint16_t ring;   // channel, 0 = lowest elevation
   std::int64_t t;       // ns, the time of the point's column
-  std::int32_t cone;    // ground truth: cone index hit, -1 ground
+  std::int32_t cone;    // ground truth: cone index hit, kHitGround, kHitStructure
 };
 
 class Lidar {
@@ -336,7 +352,7 @@ class Lidar {
   double vertical_resolution() const;    // rad
   double horizontal_resolution() const;  // rad
   // the beams the last LidarCast::Exploit scan cast through the whole scene
-  // (those in some cone's window)
+  // (those in some cone's or block's window)
   std::size_t window_beams() const { return window_rays_.size(); }
 
  private:

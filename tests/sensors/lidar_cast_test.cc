@@ -12,7 +12,9 @@
 // scattered field with knocked cones, a cone against the sensor and cones at
 // the range limit, on flat, sloped, bumpy and sloped-bumpy ground, with a
 // car that drives and turns through the rotation (the windows must follow
-// it), a pitched sensor, noise and dropout.
+// it), a pitched sensor, noise and dropout; and the same with the venue's
+// barrier blocks (rows along the curve, tents, a block across the range
+// limit, one against the sensor).
 #include "sim/sensors/lidar.h"
 
 #include <gtest/gtest.h>
@@ -32,6 +34,7 @@ namespace {
 struct Scene {
   std::vector<Cone> cones;
   std::vector<bool> knocked;
+  std::vector<world::Block> blocks;
 };
 
 // a splitmix64 stream in [0, 1)
@@ -44,7 +47,7 @@ double uniform01(std::uint64_t& state) {
 }
 
 // the car starts at the origin looking along +x (the sensor 2.2 m ahead)
-Scene make_scene() {
+Scene make_scene(bool blocks) {
   Scene s;
   const auto add = [&s](Vec2 p, ConeColor c, bool down) {
     s.cones.push_back({p, c});
@@ -76,6 +79,21 @@ Scene make_scene() {
     const double a = 2.0 * kPi * i / 24.0, r = 49.8 + 0.05 * (i % 8);
     add({2.2 + r * std::cos(a), r * std::sin(a)}, ConeColor::BigOrange, i % 3 == 0);
   }
+  if (!blocks) return s;
+  // rows of 2 m barrier blocks 5 m either side of the curve, a gap every tenth
+  for (int i = 0; i < 60; ++i) {
+    if (i % 10 == 9) continue;
+    const double a = (2.0 * i + 1.0) / 40.0, side = i % 2 == 0 ? 5.0 : -5.0;
+    const Vec2 centre{40.0 * std::sin(a), 40.0 - 40.0 * std::cos(a)};
+    const Vec2 n{-std::sin(a), std::cos(a)};
+    s.blocks.push_back({centre + side * n, a, 1.95, 0.6, 1.0});
+  }
+  // tents and odd boxes around, one reaching over the sensor's height, one
+  // across the range limit, one just beside the sensor
+  s.blocks.push_back({{-12.0, 9.0}, 0.3, 3.0, 3.0, 2.5});
+  s.blocks.push_back({{10.0, -20.0}, -0.7, 6.0, 4.0, 3.0});
+  s.blocks.push_back({{2.2 + 50.0, 1.0}, 1.2, 2.0, 0.6, 1.0});
+  s.blocks.push_back({{2.2, 1.2}, 0.0, 1.0, 0.4, 0.8});
   return s;
 }
 
@@ -151,19 +169,21 @@ struct Case {
   bool moving;
   double pitch;  // rad
   bool noise;
+  bool blocks = false;
 };
 
 void PrintTo(const Case& k, std::ostream* os) {
   *os << k.ground << (k.moving ? " moving" : " still") << " pitch " << k.pitch
-      << (k.noise ? " noisy" : "");
+      << (k.noise ? " noisy" : "") << (k.blocks ? " blocks" : "");
 }
 
 class LidarCastSame : public ::testing::TestWithParam<Case> {};
 
 TEST_P(LidarCastSame, ExploitMatchesTheWholeScenePointByPoint) {
   const Case k = GetParam();
-  const Scene s = make_scene();
-  LidarWorld world(s.cones, s.knocked, ground(k.ground));
+  const Scene s = make_scene(k.blocks);
+  LidarWorld world(s.cones, s.knocked, ground(k.ground), s.blocks);
+  EXPECT_EQ(world.block_count(), s.blocks.size());
   LidarParams p;
   p.mount_pitch = k.pitch;
   if (k.noise) {
@@ -174,18 +194,20 @@ TEST_P(LidarCastSame, ExploitMatchesTheWholeScenePointByPoint) {
   }
   const auto traj = trajectory(k.moving);
   const std::string what = k.ground + (k.moving ? " moving" : " at rest") +
-                           (k.pitch != 0.0 ? " pitched" : "") + (k.noise ? " noisy" : "");
+                           (k.pitch != 0.0 ? " pitched" : "") + (k.noise ? " noisy" : "") +
+                           (k.blocks ? " blocks" : "");
   const TimeNs start = from_seconds(0.3);
   // three scans in a row from each sensor: the streams must stay in step
   Lidar fast(p, 77), single(p, 77), packets(p, 77);
   Compared single_cmp, packets_cmp;
-  std::size_t window = 0;
+  std::size_t window = 0, block_points = 0;
   for (int scan = 0; scan < 3; ++scan) {
     const TimeNs t0 = start + scan * fast.period_ns();
     const auto a = fast.scan(world, traj, t0, LidarCast::Exploit);
     window += fast.window_beams();
     const auto b = single.scan(world, traj, t0, LidarCast::Single);
     const auto c = packets.scan(world, traj, t0, LidarCast::Packets);
+    for (const LidarPoint& q : b) block_points += q.cone == kHitStructure;
     // within a few float ulps of the range; the intensity follows the range
     // (through 1/r^2 and the stripe at the hit's height) and the facet
     const Compared x = compare(a, b, 1e-5, 1e-5, what + " vs single");
@@ -204,10 +226,16 @@ TEST_P(LidarCastSame, ExploitMatchesTheWholeScenePointByPoint) {
               single_cmp.worst_range, packets_cmp.identical, packets_cmp.worst_range);
   EXPECT_GT(single_cmp.points, 3u * 10000u);
   EXPECT_GT(single_cmp.cone_points, 3u * 300u);
+  if (k.blocks) {
+    EXPECT_GT(block_points, 3u * 1000u);
+  } else {
+    EXPECT_EQ(block_points, 0u);
+  }
   EXPECT_EQ(world.ground_closed_form(), flat(world.ground()));
   if (flat(world.ground())) {
     EXPECT_GT(window, 3u * 300u);
-    EXPECT_LT(window, 3u * 32u * 1024u / 2u);  // the windows are the cones', not the whole scan
+    // the windows are the cones' (and blocks'), not the whole scan
+    EXPECT_LT(window, 3u * 32u * 1024u / (k.blocks ? 1u : 2u));
     // the closed form is Embree's own arithmetic: the same scan to the bit
     EXPECT_EQ(packets_cmp.identical, packets_cmp.points) << what;
   } else {
@@ -220,10 +248,12 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Case{"flat", false, 0.0, false}, Case{"flat", true, 0.0, true},
                       Case{"flat", true, 0.06, true}, Case{"sloped", true, 0.0, true},
                       Case{"bumpy", true, 0.0, true}, Case{"sloped_bumpy", false, 0.0, false},
-                      Case{"sloped_bumpy", true, -0.04, true}),
+                      Case{"sloped_bumpy", true, -0.04, true}, Case{"flat", false, 0.0, false, true},
+                      Case{"flat", true, 0.06, true, true}, Case{"sloped_bumpy", true, 0.0, true, true}),
     [](const ::testing::TestParamInfo<Case>& i) {
       return i.param.ground + (i.param.moving ? "_moving" : "_still") +
-             (i.param.pitch != 0.0 ? "_pitched" : "") + (i.param.noise ? "_noisy" : "");
+             (i.param.pitch != 0.0 ? "_pitched" : "") + (i.param.noise ? "_noisy" : "") +
+             (i.param.blocks ? "_blocks" : "");
     });
 
 }  // namespace

@@ -148,6 +148,61 @@ TEST_P(LidarSingleCone, HitsLieOnTheConeAndCountIsNearExpected) {
 
 INSTANTIATE_TEST_SUITE_P(LidarRanges, LidarSingleCone, ::testing::Values(5.0, 10.0));
 
+// a barrier block 8 m ahead of the sensor, across its view: its near face is
+// the plane x = mount_x + 8 (world), 4 m wide, 2 m high on flat ground. Every
+// beam whose ray meets that rectangle (computed here from the layout's
+// elevations and azimuths alone) returns from it with the range of the
+// ray/plane intersection and the block's intensity, labelled a structure;
+// no other beam does
+TEST(LidarBlock, ItsFaceIsHitExactlyWhereTheBeamsMeetTheRectangle) {
+  const LidarParams p = noiseless();
+  const double face = p.mount_x + 8.0, half = 2.0, height = 2.0;
+  const world::Block block{{face + 0.3, 0.0}, kPi / 2.0, 2.0 * half, 0.6, height};
+  LidarWorld world({}, {}, {}, {block});
+  ASSERT_EQ(world.block_count(), 1u);
+  Lidar lidar(p, 1);
+  const std::vector<LidarPoint> pts = lidar.scan(world, at_rest(), 0);
+  // the beams that meet the face, well inside its edges (1 cm)
+  int expected = 0, edge = 0;
+  for (int c = 0; c < p.columns; ++c) {
+    const double az = -kPi + 2.0 * kPi * c / p.columns;
+    if (std::cos(az) <= 0.0) continue;
+    for (int j = 0; j < p.channels; ++j) {
+      const double el = p.elevation_min + (p.elevation_max - p.elevation_min) * j / (p.channels - 1);
+      const double t = 8.0 / (std::cos(el) * std::cos(az));  // the range to the plane
+      const double y = t * std::cos(el) * std::sin(az), z = p.mount_z + t * std::sin(el);
+      const double inside = std::min({half - std::abs(y), z, height - z});
+      if (z < 0.0) continue;  // the ground first
+      if (inside > 0.01) ++expected;
+      else if (inside > -0.01) ++edge;
+    }
+  }
+  int hits = 0;
+  double worst = 0.0;
+  for (const LidarPoint& q : pts) {
+    if (q.cone != kHitStructure) {
+      EXPECT_EQ(q.cone, kHitGround);
+      continue;
+    }
+    ++hits;
+    const P3 w = to_world(q, Pose2{}, p);
+    worst = std::max(worst, std::abs(w.x - face));
+    EXPECT_LE(std::abs(w.y), half + 1e-3);
+    EXPECT_GE(w.z, -1e-3);
+    EXPECT_LE(w.z, height + 1e-3);
+    // Lambert on the face (normal along x): rho cos(inc) min(1, (5 / r)^2)
+    const double r = range_of(q);
+    const double cos_inc = (w.x - p.mount_x) / r;
+    EXPECT_NEAR(q.intensity, p.reflect_barrier * cos_inc * std::min(1.0, 25.0 / (r * r)), 1e-4);
+  }
+  std::printf("block face 8 m ahead: %d hits, %d expected inside, %d on the edges; worst off the face %.2e m\n",
+              hits, expected, edge, worst);
+  EXPECT_LT(worst, 1e-4);
+  EXPECT_GE(hits, expected);
+  EXPECT_LE(hits, expected + edge);
+  EXPECT_GT(expected, 500);
+}
+
 TEST(LidarTest, GroundHitsLieOnTheGroundAndAreInRange) {
   const LidarParams p = noiseless();
   LidarWorld world({});
