@@ -166,6 +166,14 @@ SlamMetrics SlamScorer::metrics(const SimModel& model, const SimState& state, co
   m.ate_rms = std::sqrt(sum2_ / static_cast<double>(n_));
   m.heading_rms = std::sqrt(heading2_ / static_cast<double>(n_));
   m.ate_max = max_;
+  std::vector<Pose2> truth, estimate;
+  truth.reserve(series_.size());
+  estimate.reserve(series_.size());
+  for (const SlamSample& x : series_) {
+    truth.push_back(x.truth);
+    estimate.push_back(x.estimate);
+  }
+  m.drift = relative_drift(truth, estimate, 100.0, 10.0);
   return m;
 }
 

@@ -114,6 +114,7 @@ struct SlamMetrics {
   double ate_rms = 0.0;      // m, position error (absolute trajectory error)
   double ate_max = 0.0;      // m
   double heading_rms = 0.0;  // rad
+  Drift drift;               // over 100 m windows of the drive (relative_drift)
   long samples = 0;
   std::vector<SlamLap> laps;       // per lap of the event
   MapMetrics map;                  // the stack's final map (cone_map.min_observations)

@@ -46,6 +46,9 @@ std::vector<std::string> check_expectations(const Expectations& e, const RunResu
   if (e.lateral_error_max && r.tracking.max > *e.lateral_error_max) {
     failed.push_back("lateral max: expected at most " + fixed(*e.lateral_error_max, 3) + " m, got " + fixed(r.tracking.max, 3) + " m");
   }
+  if (e.ate_rms_max && r.slam.ate_rms > *e.ate_rms_max) {
+    failed.push_back("ATE rms: expected at most " + fixed(*e.ate_rms_max, 3) + " m, got " + fixed(r.slam.ate_rms, 3) + " m");
+  }
   if (e.fallbacks_max && r.fallbacks > *e.fallbacks_max) {
     failed.push_back("fallbacks: expected at most " + std::to_string(*e.fallbacks_max) + ", got " + std::to_string(r.fallbacks));
   }
@@ -80,6 +83,10 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
     << fixed(r.tracking.itae, 1) << " (mean per lap)\n";
   o << "  slam        " << stack::to_string(s.autonomy.slam) << ": ATE rms " << fixed(r.slam.ate_rms, 3) << " m, max "
     << fixed(r.slam.ate_max, 3) << " m, heading rms " << fixed(r.slam.heading_rms, 4) << " rad\n";
+  if (r.slam.drift.windows > 0) {
+    o << "              drift over 100 m: " << fixed(r.slam.drift.translation, 3) << " m, "
+      << fixed(r.slam.drift.rotation, 4) << " rad (mean of " << r.slam.drift.windows << " windows)\n";
+  }
   const MapMetrics& mm = r.slam.map;
   o << "              map " << mm.map_cones << " cones: rmse " << fixed(mm.rmse, 3) << " m, precision "
     << fixed(100.0 * mm.precision, 1) << " %, recall " << fixed(100.0 * mm.recall, 1) << " % (of " << mm.true_cones
@@ -135,6 +142,8 @@ nlohmann::json slam_json(const Scenario& s, const SlamMetrics& m) {
           {"ate_rms_m", m.ate_rms},
           {"ate_max_m", m.ate_max},
           {"heading_rms_rad", m.heading_rms},
+          {"drift_m_per_100m", m.drift.translation},
+          {"drift_rad_per_100m", m.drift.rotation},
           {"samples", m.samples},
           {"map_cones", m.map.map_cones},
           {"map_rmse_m", m.map.rmse},

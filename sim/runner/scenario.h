@@ -82,6 +82,7 @@ struct Expectations {
   std::optional<double> lateral_rms_max;
   std::optional<double> lateral_error_max;
   std::optional<int> fallbacks_max;
+  std::optional<double> ate_rms_max;
 
   template <class V>
   void visit(V& v) {
@@ -97,6 +98,7 @@ struct Expectations {
     v(PADDOCK_PARAM(lateral_rms_max), {"m", positive, "RMS lateral error at most"});
     v(PADDOCK_PARAM(lateral_error_max), {"m", positive, "largest lateral error at most"});
     v(PADDOCK_PARAM(fallbacks_max), {"", count, "safe-stop control cycles, at most"});
+    v(PADDOCK_PARAM(ate_rms_max), {"m", positive, "the state estimate's RMS position error (ATE) at most"});
   }
 };
 

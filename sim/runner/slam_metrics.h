@@ -28,4 +28,19 @@ struct MapMetrics {
 MapMetrics map_metrics(const std::vector<Cone>& map, const std::vector<Cone>& truth, const std::vector<Vec2>& path,
                        double match_radius = 1.0, double corridor = 5.0);
 
+// the estimate's drift over a given distance (KITTI's relative error): for
+// every window of `length` metres of true travel, one starting every `step`
+// metres, the estimate's motion over the window against the truth's, both
+// in the frame of the window's start: E = (T_i^-1 T_j)^-1 (S_i^-1 S_j) (T
+// the true poses, S the estimates). The translation and rotation of E, as
+// means over the windows; a window closes at the first sample at least
+// `length` along. No window (a drive shorter than `length`): zeros.
+struct Drift {
+  double translation = 0.0;  // m over `length`
+  double rotation = 0.0;     // rad over `length`
+  int windows = 0;
+};
+Drift relative_drift(const std::vector<Pose2>& truth, const std::vector<Pose2>& estimate, double length = 100.0,
+                     double step = 10.0);
+
 }  // namespace paddock::runner

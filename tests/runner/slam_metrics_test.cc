@@ -57,5 +57,40 @@ TEST(MapMetrics, TheMatchRadiusAndTheCorridorAreBounds) {
   EXPECT_EQ(map_metrics({}, {}, kPath).recall, 1.0);
 }
 
+// the drift over 100 m windows, against hand-computed cases: an estimate
+// that reads every distance 1 % long drifts 1 m per 100 m whatever the
+// offset and heading it starts with; one whose heading turns 0.01 rad per
+// 100 m more than the truth on a straight drifts that much, and the chord's
+// error 100 sin(0.01 / 2) ~ 0.5 m (the heading error grows linearly along
+// the window: the mean direction is off by half the turn)
+TEST(Drift, ScaleAndHeadingErrorsGiveTheirClosedForms) {
+  // samples every 0.125 m (exact in binary: the windows close exactly at 100 m)
+  std::vector<Pose2> truth, scaled, turning;
+  for (int i = 0; i <= 2400; ++i) {
+    const double s = 0.125 * i;  // 300 m along x
+    truth.push_back({s, 0.0, 0.0});
+    // offset by (5, -2) and turned by 1 rad: the relative motion is the same
+    const Vec2 p = rotate(Vec2{1.01 * s, 0.0}, 1.0) + Vec2{5.0, -2.0};
+    scaled.push_back({p.x, p.y, 1.0});
+    // the heading turns 1e-4 rad per metre: an arc of radius 1e4 m
+    const double k = 1e-4, a = k * s;
+    turning.push_back({std::sin(a) / k, (1.0 - std::cos(a)) / k, a});
+  }
+  const Drift d = relative_drift(truth, scaled, 100.0, 10.0);
+  EXPECT_EQ(d.windows, 21);  // windows starting at 0, 10, ..., 200 m
+  EXPECT_NEAR(d.translation, 1.0, 1e-9);
+  EXPECT_NEAR(d.rotation, 0.0, 1e-12);
+  const Drift e = relative_drift(truth, turning, 100.0, 10.0);
+  EXPECT_NEAR(e.rotation, 0.01, 1e-9);
+  // chord of the arc of 100 m: 2 R sin(a / 2) long at a / 2 off the x axis,
+  // against 100 m along x
+  const double R = 1e4, a = 0.01, chord = 2.0 * R * std::sin(a / 2.0);
+  EXPECT_NEAR(e.translation, std::hypot(chord * std::cos(a / 2.0) - 100.0, chord * std::sin(a / 2.0)), 1e-6);
+  EXPECT_NEAR(e.translation, 0.5, 0.01);
+  // shorter than a window: none
+  EXPECT_EQ(relative_drift({truth.begin(), truth.begin() + 700}, scaled, 100.0, 10.0).windows, 0);
+  EXPECT_EQ(relative_drift(truth, truth).translation, 0.0);
+}
+
 }  // namespace
 }  // namespace paddock::runner
