@@ -57,7 +57,10 @@
 // prior holds the free directions, the IMU alone moves them); the slice is
 // counted and its status says so.
 //
-// The map: a hashed voxel map (voxel_map.h), points in the world frame.
+// The map: a hashed voxel map (voxel_map.h), points in the world frame,
+// trimmed to [lio.map] reach around the IMU after each rotation (1000 m,
+// FAST-LIO2's default cube: a whole FS track is kept, and each lap after the
+// first localises against the first lap's map).
 //
 // LIMO-Velo's adaptations, as adopted here:
 // - partial scans: a rotation is processed in slices of `slice` seconds (its

@@ -336,7 +336,7 @@ TEST(VoxelMap, RemoveOutsideKeepsExactlyThePointsWithinReach) {
     map.knn(q, 5, 0.5, out);
     expect_same(out, brute_knn(want, q, 5, 0.5), "after re-insertion");
   }
-  // the params' reach (60 m) keeps all of it
+  // the params' reach (1000 m) keeps all of it
   EXPECT_EQ(map.remove_outside({0.0, 0.0, 0.0}), 0u);
   EXPECT_EQ(map.size(), want.size());
 }
