@@ -404,20 +404,7 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
         }
         put(vk + 3 * (2 * kConeSegments), 0.0, 0.0, h);
         // its bounds, from the float vertices
-        double lo[3] = {vk[0], vk[1], vk[2]}, hi[3] = {vk[0], vk[1], vk[2]};
-        for (int q = 1; q < kConeVertices; ++q) {
-          for (int a = 0; a < 3; ++a) {
-            lo[a] = std::min(lo[a], static_cast<double>(vk[3 * q + a]));
-            hi[a] = std::max(hi[a], static_cast<double>(vk[3 * q + a]));
-          }
-        }
-        Bounds b{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]),
-                 0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]), 0.5 * (hi[2] - lo[2]), 0.0};
-        for (int q = 0; q < kConeVertices; ++q) {
-          const double dx = vk[3 * q] - b.x, dy = vk[3 * q + 1] - b.y, dz = vk[3 * q + 2] - b.z;
-          b.r = std::max(b.r, std::sqrt(dx * dx + dy * dy + dz * dz));
-        }
-        bounds_.push_back(b);
+        bounds_.push_back(bounds_of(vk, kConeVertices));
         const auto base = static_cast<unsigned>(kConeVertices * k);
         unsigned* ik = idx + 3 * kConeTriangles * k;
         const auto segs = static_cast<unsigned>(kConeSegments);
@@ -470,20 +457,7 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
           lo[2] = static_cast<float>(z0);
           hi[2] = static_cast<float>(top);
         }
-        double lo[3] = {vk[0], vk[1], vk[2]}, hi[3] = {vk[0], vk[1], vk[2]};
-        for (int q = 1; q < kBlockVertices; ++q) {
-          for (int a = 0; a < 3; ++a) {
-            lo[a] = std::min(lo[a], static_cast<double>(vk[3 * q + a]));
-            hi[a] = std::max(hi[a], static_cast<double>(vk[3 * q + a]));
-          }
-        }
-        Bounds b{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]),
-                 0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]), 0.5 * (hi[2] - lo[2]), 0.0};
-        for (int q = 0; q < kBlockVertices; ++q) {
-          const double dx = vk[3 * q] - b.x, dy = vk[3 * q + 1] - b.y, dz = vk[3 * q + 2] - b.z;
-          b.r = std::max(b.r, std::sqrt(dx * dx + dy * dy + dz * dz));
-        }
-        bounds_.push_back(b);
+        bounds_.push_back(bounds_of(vk, kBlockVertices));
         const auto base = static_cast<unsigned>(kBlockVertices * k);
         unsigned* ik = idx + 3 * kBlockTriangles * k;
         for (unsigned s = 0; s < 4; ++s) {
@@ -510,6 +484,23 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
     rtcReleaseDevice(device_);
     throw;
   }
+}
+
+LidarWorld::Bounds LidarWorld::bounds_of(const float* v, int n) {
+  double lo[3] = {v[0], v[1], v[2]}, hi[3] = {v[0], v[1], v[2]};
+  for (int q = 1; q < n; ++q) {
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], static_cast<double>(v[3 * q + a]));
+      hi[a] = std::max(hi[a], static_cast<double>(v[3 * q + a]));
+    }
+  }
+  Bounds b{0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]),
+           0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1]), 0.5 * (hi[2] - lo[2]), 0.0};
+  for (int q = 0; q < n; ++q) {
+    const double dx = v[3 * q] - b.x, dy = v[3 * q + 1] - b.y, dz = v[3 * q + 2] - b.z;
+    b.r = std::max(b.r, std::sqrt(dx * dx + dy * dy + dz * dz));
+  }
+  return b;
 }
 
 LidarWorld::~LidarWorld() {

@@ -299,6 +299,8 @@ class LidarWorld {
     double r;
   };
   std::vector<Bounds> bounds_;
+  // the bounds of the n float vertices at v (x, y, z each)
+  static Bounds bounds_of(const float* v, int n);
   // flat ground: the quad's corners as Embree holds them, and the z of its
   // triangles' geometric normal Ng = cross(e2, e1) (both triangles have
   // Ng = (0, 0, (x1 - x0)(y1 - y0)) in float)
