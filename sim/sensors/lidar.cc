@@ -232,8 +232,11 @@ LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& 
     throw std::invalid_argument("LidarWorld: knocked must be empty or of the size of cones");
   }
   params::require_valid(ground_, "LidarWorld: GroundParams");
-  // one worker thread: many simulations may run side by side in one process
-  device_ = rtcNewDevice("threads=1");
+  // one worker thread: many simulations may run side by side in one process.
+  // Embree picks its kernels by the CPU, and they round differently (the
+  // default run's log differs between SSE/AVX, AVX2 and AVX-512 machines):
+  // capped at AVX2, every machine with AVX2 and FMA gives the same result
+  device_ = rtcNewDevice("threads=1,max_isa=avx2");
   if (device_ == nullptr) {
     throw LidarError(std::string("LidarWorld: rtcNewDevice failed: ") +
                      error_name(rtcGetDeviceError(nullptr)));

@@ -138,9 +138,15 @@ TEST(Cli, SameScenarioAndSeedGiveIdenticalSummaryAndLog) {
   // and the same as the build that pinned it: a change of any result shows here
   char hash[19];
   std::snprintf(hash, sizeof hash, "0x%016llx", static_cast<unsigned long long>(fnv1a64(log_a)));
-  EXPECT_EQ(std::string(hash), pinned_log_hash())
-      << "the default run's log changed; if on purpose, set log_fnv1a64 = " << hash
-      << " in tests/data/determinism.txt and say why in the commit";
+  // (pinned for machines with AVX2 and FMA, Embree's kernels and glibc's
+  // libm the same there; other machines round differently)
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    EXPECT_EQ(std::string(hash), pinned_log_hash())
+        << "the default run's log changed; if on purpose, set log_fnv1a64 = " << hash
+        << " in tests/data/determinism.txt and say why in the commit";
+  } else {
+    std::printf("no AVX2 and FMA here: the log's hash %s is not compared with the pinned one\n", hash);
+  }
   const std::string sum_a = paddock::runner::read_file(scratch("det_a") + "/summary.json");
   const std::string sum_b = paddock::runner::read_file(scratch("det_b") + "/summary.json");
   EXPECT_EQ(without_wall_clock(sum_a), without_wall_clock(sum_b));

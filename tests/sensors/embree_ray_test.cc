@@ -60,7 +60,11 @@ TEST_F(OneWall, PacketLanesHitWherePlaneGeometrySays) {
   rtcIntersect16(valid, scene_, &context, &rh);
   for (int k = 0; k < 16; ++k) {
     EXPECT_EQ(rh.ray.id[k], static_cast<unsigned>(k));
-    if (k >= 12 || k == 3) {
+    // masked lanes: Embree's manual says their hit data is left alone, but
+    // Debian's Embree 3 on an AVX2 machine (no AVX-512) writes it, so the
+    // sensors read the valid lanes only and this checks nothing of them
+    if (k >= 12) continue;
+    if (k == 3) {
       EXPECT_EQ(rh.hit.geomID[k], RTC_INVALID_GEOMETRY_ID) << k;
       continue;
     }
