@@ -4,7 +4,10 @@
 // field is one a part of the car fills (or, for a command, takes): nothing
 // that only a simulator knows (tests/hal/messages_test.cc names the part
 // behind each field and fails on a field without one).
+#include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <variant>
 #include <vector>
@@ -50,7 +53,23 @@ struct DetectedCone {
 struct ConeDetections {
   TimeNs stamp = 0;  // when the cones were measured; the message arrives later (latency)
   std::vector<DetectedCone> cones;
+  // what hides the cones behind it: per bearing bin of the base frame at
+  // `stamp` (free_range_bin), the horizontal range (m) of the nearest
+  // obstacle that is no cone (a barrier, a wall), +infinity where none was
+  // seen; empty when the node reports none (a cone beyond it in its bin is
+  // hidden, not missing)
+  std::vector<float> free_range;
 };
+
+// the bin of free_range (n bins) that holds `bearing` (rad, base frame):
+// bin i covers [-pi + i 2 pi / n, -pi + (i + 1) 2 pi / n); a bearing off
+// [-pi, pi) is wrapped onto the circle
+inline std::size_t free_range_bin(double bearing, std::size_t n) {
+  if (n == 0 || !std::isfinite(bearing)) return 0;
+  const double f = std::floor((bearing + kPi) / (2.0 * kPi) * static_cast<double>(n));
+  const double w = f - std::floor(f / static_cast<double>(n)) * static_cast<double>(n);
+  return std::min(n - 1, static_cast<std::size_t>(std::max(0.0, w)));
+}
 
 // the inertial measurement unit, six axes: specific force (what an
 // accelerometer measures: acceleration minus gravity, so a level car at rest

@@ -1,5 +1,9 @@
 #include "autonomy/perception/lidar_pipeline.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 namespace paddock::perception {
 
 std::string LidarPipelineParams::check() const {
@@ -67,6 +71,17 @@ LidarResult LidarPipeline::process(const hal::LidarScan& scan, const Odometry* o
   counts.rejected_shape = fs.rejected_shape;
   counts.rejected_density = fs.rejected_density;
   counts.cones = fs.accepted;
+
+  // the free-space boundary: the nearest return per bearing that stands
+  // higher than any cone above its ground
+  const auto bins = static_cast<std::size_t>(params_.free_range_bins);
+  out.free_range.assign(bins, std::numeric_limits<float>::infinity());
+  for (const CloudPoint& p : cloud_.points) {
+    if (p.label == PointLabel::Ground || !(p.height > params_.occluder_min_height)) continue;
+    const double x = p.x, y = p.y;
+    float& f = out.free_range[hal::free_range_bin(std::atan2(y, x), bins)];
+    f = std::min(f, static_cast<float>(std::hypot(x, y)));
+  }
 
   // colour from the intensity profile
   out.cones.reserve(cone_clusters_.size());

@@ -43,9 +43,16 @@ struct LidarPipelineParams {
   // keep the corrected points with their labels in the result (for plots):
   // not visited, a run-time switch (Perception::set_keep_points)
   bool keep_points = false;
+  // the free-space boundary (LidarResult::free_range): a non-ground return
+  // this high above its local ground is no cone (a big cone is 0.505 m) but
+  // something that hides what lies behind it (a barrier, a wall, a tent)
+  double occluder_min_height = 0.6;
+  int free_range_bins = 360;
 
   template <class V>
   void visit(V& v) {
+    v(PADDOCK_PARAM(occluder_min_height), {"m", params::above(0.0), "a non-ground return this high above its ground is an obstacle that hides cones"});
+    v(PADDOCK_PARAM(free_range_bins), {"", params::in(1, 36000), "bearing bins of the free-space boundary"});
     v.section(PADDOCK_PARAM(ground), "the ground removal (slope-robust cascaded segmentation)");
     v.section(PADDOCK_PARAM(clustering), "the Euclidean clustering of the non-ground points");
     v.section(PADDOCK_PARAM(cone), "the cone reconstruction and the rule-based cone filters");
@@ -89,6 +96,10 @@ struct LidarResult {
   TimeNs stamp = 0;        // the reference time: scan.end
   bool corrected = false;  // motion-corrected with the odometry
   std::vector<ConeCandidate> cones;
+  // per bearing bin (hal::free_range_bin, free_range_bins of them) of the
+  // base frame at `stamp`: the horizontal range of the nearest return higher
+  // than occluder_min_height above its local ground, +infinity if none
+  std::vector<float> free_range;
   LidarCounts counts;
   std::vector<LabelledPoint> points;  // keep_points only
 };

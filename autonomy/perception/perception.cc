@@ -48,6 +48,7 @@ const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
   hal::ConeDetections& out = last_.output;
   out.stamp = last_.lidar.stamp;
   out.cones.clear();
+  out.free_range = last_.lidar.free_range;
   if (!last_.lidar.ok) {
     ++stats_.scans_failed;
     return out;

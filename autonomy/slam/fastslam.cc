@@ -265,7 +265,8 @@ void FastSlam::prepare(const std::vector<Observation>& obs) {
   }
 }
 
-void FastSlam::update(const std::vector<Observation>& obs) {
+void FastSlam::update(const std::vector<Observation>& obs, const std::vector<float>& free_range) {
+  free_range_ = &free_range;
   prepare(obs);
 
   // each particle: sample its pose, associate, update its map; log-likelihoods
@@ -521,6 +522,12 @@ void FastSlam::expect_and_remove(Particle& p) {
       const double b2 = squared_norm(b);
       const bool in_view = b2 < pr.view_range * pr.view_range && b.x > std::sqrt(b2) * cos_fov;
       if (!in_view) continue;
+      // hidden behind an obstacle in its bearing: not expected either
+      if (free_range_ != nullptr && !free_range_->empty()) {
+        const std::vector<float>& fr = *free_range_;
+        const float edge = fr[hal::free_range_bin(std::atan2(b.y, b.x), fr.size())];
+        if (std::sqrt(b2) > static_cast<double>(edge) + pr.occlusion_margin) continue;
+      }
     }
     Slot& s = p.mutable_slot(i);
     ++s.lm.expected;

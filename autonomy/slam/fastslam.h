@@ -49,7 +49,11 @@
 // confirmed after confirm_sightings sightings.
 //
 // Removal: a landmark is expected in a frame when it lies within view_range
-// and view_half_fov of the particle's pose (or was seen). It is removed when,
+// and view_half_fov of the particle's pose (or was seen), unless the frame's
+// free-space boundary (update's free_range, from perception: the nearest
+// obstacle that is no cone, per bearing) lies more than occlusion_margin
+// nearer in its bearing: a cone behind a barrier is hidden, not missing. It
+// is removed when,
 // after remove_min_expected expectations, its sightings are below remove_ratio
 // times them (ghosts), or after remove_misses expected frames in a row
 // without a sighting (a cone that is gone: its long history of sightings
@@ -94,6 +98,7 @@
 
 #include "autonomy/common/cone.h"
 #include "autonomy/common/geometry.h"
+#include "autonomy/hal/messages.h"
 #include "autonomy/common/params.h"
 #include "autonomy/slam/cone_map.h"
 
@@ -156,6 +161,10 @@ struct FastSlamParams {
   // (the object sensor's 20 m) and field of view (180 deg), with a margin
   double view_range = 18.0;
   double view_half_fov = 80.0 * kPi / 180.0;
+  // nor where the frame's free-space boundary (update's free_range) lies
+  // nearer than the landmark by more than this: an obstacle hides it (a
+  // cone close behind a barrier's face still counts as hidden)
+  double occlusion_margin = 0.5;
   // removal: seen in fewer than remove_ratio of the frames it was expected
   // in (after remove_min_expected of them), or not seen in remove_misses
   // expected frames in a row
@@ -189,6 +198,7 @@ struct FastSlamParams {
     v(PADDOCK_PARAM(confirm_sightings), {"", params::in(1, 100000), "sightings before a landmark is confirmed"});
     v(PADDOCK_PARAM(view_range), {"m", params::above_up_to(0.0, 1000.0), "a landmark nearer than this (and in view_half_fov) is expected to be seen"});
     v(PADDOCK_PARAM(view_half_fov), {"rad", params::above_up_to(0.0, kPi), "half the field of view in which a landmark is expected to be seen"});
+    v(PADDOCK_PARAM(occlusion_margin), {"m", params::at_least(0.0), "a landmark this far beyond the frame's free-space boundary is hidden, not expected"});
     v(PADDOCK_PARAM(remove_ratio), {"", params::fraction(), "removed when seen in fewer than this share of the frames it was expected in"});
     v(PADDOCK_PARAM(remove_min_expected), {"", params::in(1, 100000), "expected frames before remove_ratio applies"});
     v(PADDOCK_PARAM(remove_misses), {"", params::in(1, 100000), "removed after this many expected frames in a row without a sighting"});
@@ -233,8 +243,11 @@ class FastSlam {
   // the motion since the last call, as the odometry measured it: the base's
   // pose change in the previous base frame
   void predict(const Pose2& delta);
-  // one frame of cone observations (base frame, at the pose after the last predict)
-  void update(const std::vector<Observation>& obs);
+  // one frame of cone observations (base frame, at the pose after the last
+  // predict) and, if the sensor gives one, its free-space boundary
+  // (hal::ConeDetections::free_range: per bearing bin the range of the
+  // nearest obstacle that hides cones; empty: none given)
+  void update(const std::vector<Observation>& obs, const std::vector<float>& free_range = {});
 
   // the highest-weight particle's pose
   Pose2 pose() const;
@@ -413,6 +426,7 @@ class FastSlam {
   std::vector<Particle> spare_;
   // scratch of update and update_particle (kept to spare the allocations)
   Frame frame_;
+  const std::vector<float>* free_range_ = nullptr;  // update()'s free-space boundary
   std::vector<double> log_lik_;
   std::vector<int> in_reach_;   // live blocks (positions) within reach
   std::vector<int> near_;       // the landmarks' indices, ascending

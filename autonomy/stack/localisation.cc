@@ -156,7 +156,7 @@ void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
     std::vector<slam::Observation> obs;
     obs.reserve(d.cones.size());
     for (const hal::DetectedCone& c : d.cones) obs.push_back({c.position, c.color, c.colour_from_camera});
-    fastslam_->update(obs);
+    fastslam_->update(obs, d.free_range);
     map_news_ = true;
     lost_run_ = lost_in_frame() ? lost_run_ + 1 : 0;
     if (lost_run_ > 0) ++stats_.lost_frames;

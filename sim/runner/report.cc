@@ -49,6 +49,9 @@ std::vector<std::string> check_expectations(const Expectations& e, const RunResu
   if (e.ate_rms_max && r.slam.ate_rms > *e.ate_rms_max) {
     failed.push_back("ATE rms: expected at most " + fixed(*e.ate_rms_max, 3) + " m, got " + fixed(r.slam.ate_rms, 3) + " m");
   }
+  if (e.map_recall_min && r.slam.map.recall < *e.map_recall_min) {
+    failed.push_back("map recall: expected at least " + fixed(*e.map_recall_min, 3) + ", got " + fixed(r.slam.map.recall, 3));
+  }
   if (e.fallbacks_max && r.fallbacks > *e.fallbacks_max) {
     failed.push_back("fallbacks: expected at most " + std::to_string(*e.fallbacks_max) + ", got " + std::to_string(r.fallbacks));
   }

@@ -83,6 +83,7 @@ struct Expectations {
   std::optional<double> lateral_error_max;
   std::optional<int> fallbacks_max;
   std::optional<double> ate_rms_max;
+  std::optional<double> map_recall_min;
 
   template <class V>
   void visit(V& v) {
@@ -99,6 +100,7 @@ struct Expectations {
     v(PADDOCK_PARAM(lateral_error_max), {"m", positive, "largest lateral error at most"});
     v(PADDOCK_PARAM(fallbacks_max), {"", count, "safe-stop control cycles, at most"});
     v(PADDOCK_PARAM(ate_rms_max), {"m", positive, "the state estimate's RMS position error (ATE) at most"});
+    v(PADDOCK_PARAM(map_recall_min), {"", params::fraction(), "the final map's recall (true cones along the path it holds) at least"});
   }
 };
 

@@ -15,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <optional>
 #include <set>
@@ -113,7 +114,8 @@ std::vector<Message> sensor_messages() {
                                        {"emergency", "RES receiver: the emergency stop"}}),
       message<ConeDetections>("ConeDetections",
                               {{"stamp", "object-level perception node: its measurement time"},
-                               {"cones", "object-level perception node: its cone list"}}),
+                               {"cones", "object-level perception node: its cone list"},
+                               {"free_range", "object-level perception node: its free-space boundary (the nearest non-cone obstacle per bearing)"}}),
       message<Imu>("Imu", {{"stamp", "IMU frame on CAN: the sensor's sample time"},
                            {"ax", "IMU accelerometer"},
                            {"ay", "IMU accelerometer"},
@@ -221,6 +223,27 @@ TEST(Messages, TheHalTakesSensorMessagesAndSendsActuatorCommands) {
   static_assert(std::is_same_v<decltype(std::declval<Hal&>().receive()), std::optional<SensorMessage>>);
   static_assert(std::is_same_v<decltype(&Hal::send), void (Hal::*)(const ActuatorCommand&)>);
   SUCCEED();
+}
+
+// free_range_bin against its definition, bearing by bearing: bin i holds
+// [-pi + i w, -pi + (i + 1) w), w = 2 pi / n, and a bearing k turns off the
+// circle lands in the same bin as the bearing itself
+TEST(Messages, FreeRangeBinsCoverTheCircleOnce) {
+  for (std::size_t n : {1u, 4u, 360u, 1000u}) {
+    const double w = 2.0 * kPi / static_cast<double>(n);
+    for (int j = 0; j < 3600; ++j) {
+      const double b = -kPi + (j + 0.5) * 2.0 * kPi / 3600.0;
+      const std::size_t i = free_range_bin(b, n);
+      ASSERT_LT(i, n);
+      EXPECT_LE(-kPi + static_cast<double>(i) * w, b + 1e-12) << n << " " << b;
+      EXPECT_GT(-kPi + static_cast<double>(i + 1) * w, b - 1e-12) << n << " " << b;
+      EXPECT_EQ(free_range_bin(b + 2.0 * kPi, n), i);
+      EXPECT_EQ(free_range_bin(b - 4.0 * kPi, n), i);
+    }
+    EXPECT_EQ(free_range_bin(kPi, n), 0u) << "pi is -pi";
+    EXPECT_EQ(free_range_bin(std::nan(""), n), 0u);
+  }
+  EXPECT_EQ(free_range_bin(1.0, 0), 0u);
 }
 
 }  // namespace

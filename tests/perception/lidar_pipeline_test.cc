@@ -21,6 +21,7 @@
 
 #include "sim/sensors/lidar.h"
 #include "sim/world/track.h"
+#include "sim/world/venue.h"
 
 namespace paddock::perception {
 namespace {
@@ -479,6 +480,82 @@ TEST(LidarPipelineTest, FsgTrackPrecisionRecallAndPositionError) {
   EXPECT_GE(precision, 0.9);
   EXPECT_GE(recall, 0.9);
   EXPECT_LT(mean, 0.1);
+}
+
+// the free-space boundary (LidarResult::free_range) on FSG 2023 among the
+// venue's barriers, 3 m outside the boundary cones, against a 2-D ray cast
+// of the blocks' footprints done here: per 1-degree bin, the nearest block
+// face over 20 rays across the bin. Cones never count as obstacles (the
+// same track without barriers gives no finite bin at all).
+double ray_to_block(Vec2 dir, const std::vector<world::Block>& blocks) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const world::Block& b : blocks) {
+    const std::vector<Vec2> c = world::block_corners(b);
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const Vec2 p = c[i], q = c[(i + 1) % c.size()], e = q - p;
+      const double den = dir.x * e.y - dir.y * e.x;  // ray t dir = p + s e
+      if (std::abs(den) < 1e-12) continue;
+      const double t = (p.x * e.y - p.y * e.x) / den;
+      const double u = (p.x * dir.y - p.y * dir.x) / den;
+      if (t > 0.0 && u >= 0.0 && u <= 1.0) best = std::min(best, t);
+    }
+  }
+  return best;
+}
+
+TEST(LidarPipelineTest, FreeRangeIsTheNearestBarrierAndNeverACone) {
+  const world::TrackModel track = fsg_2023();
+  world::VenueParams vp;
+  vp.barrier_offset = 3.0;
+  const std::vector<world::Block> blocks = world::venue_blocks(track, track.cones, vp);
+  ASSERT_GT(blocks.size(), 100u);
+  sensors::LidarParams lp;
+  sensors::LidarWorld with(track.cones, {}, {}, blocks), without(track.cones);
+  sensors::Lidar lidar(lp, 22);
+  LidarPipeline pipeline(pipeline_params(lp));
+  const std::size_t bins = static_cast<std::size_t>(LidarPipelineParams{}.free_range_bins);
+  int compared = 0, agree = 0, phantom = 0, finite = 0, finite_without = 0;
+  const std::size_t n = track.centreline.size();
+  for (std::size_t k = 0; k < 8; ++k) {
+    const std::size_t i = k * n / 8;
+    const Vec2 p = track.centreline[i], q = track.centreline[(i + 1) % n];
+    const Pose2 base{p.x, p.y, angle_of(q - p)};
+    const LidarResult bare = pipeline.process(make_scan(lidar, without, at_rest(base), 0).scan, nullptr);
+    ASSERT_TRUE(bare.ok) << bare.status;
+    ASSERT_EQ(bare.free_range.size(), bins);
+    for (float f : bare.free_range) finite_without += std::isfinite(f);
+    const LidarResult res = pipeline.process(make_scan(lidar, with, at_rest(base), 0).scan, nullptr);
+    ASSERT_TRUE(res.ok) << res.status;
+    ASSERT_EQ(res.free_range.size(), bins);
+    // the blocks in the base frame
+    std::vector<world::Block> local = blocks;
+    for (world::Block& b : local) {
+      b.centre = base.inverse_transform(b.centre);
+      b.yaw -= base.yaw;
+    }
+    for (std::size_t j = 0; j < bins; ++j) {
+      double truth = std::numeric_limits<double>::infinity();
+      for (int r = 0; r < 20; ++r) {
+        const double bearing = -kPi + (static_cast<double>(j) + (r + 0.5) / 20.0) * 2.0 * kPi / static_cast<double>(bins);
+        truth = std::min(truth, ray_to_block(unit_from_angle(bearing), local));
+      }
+      const double f = res.free_range[j];
+      finite += std::isfinite(f);
+      if (std::isfinite(f) && f < truth - 0.25) ++phantom;
+      // a barrier 6-25 m away stands in the beams above 0.6 m and in range
+      if (truth >= 6.0 && truth <= 25.0) {
+        ++compared;
+        agree += std::abs(f - truth) <= 0.25;
+      }
+    }
+  }
+  std::printf("free range on FSG 2023 among barriers, 8 poses: %d of %d bins with a barrier 6-25 m away "
+              "agree within 0.25 m; %d of %d finite bins nearer than any barrier; %d finite bins without barriers\n",
+              agree, compared, phantom, finite, finite_without);
+  EXPECT_EQ(finite_without, 0) << "a cone is never an obstacle";
+  ASSERT_GT(compared, 200);
+  EXPECT_GE(agree, 0.9 * compared);
+  EXPECT_LE(phantom, finite / 100);
 }
 
 // ------------------------------------------------------------- bad data
