@@ -266,7 +266,8 @@ void FastSlam::prepare(const std::vector<Observation>& obs) {
 }
 
 void FastSlam::update(const std::vector<Observation>& obs, const std::vector<float>& free_range) {
-  free_range_ = &free_range;
+  // (a boundary with no obstacle in it hides nothing: skipped)
+  free_range_ = std::any_of(free_range.begin(), free_range.end(), [](float f) { return std::isfinite(f); }) ? &free_range : nullptr;
   prepare(obs);
 
   // each particle: sample its pose, associate, update its map; log-likelihoods
@@ -523,7 +524,7 @@ void FastSlam::expect_and_remove(Particle& p) {
       const bool in_view = b2 < pr.view_range * pr.view_range && b.x > std::sqrt(b2) * cos_fov;
       if (!in_view) continue;
       // hidden behind an obstacle in its bearing: not expected either
-      if (free_range_ != nullptr && !free_range_->empty()) {
+      if (free_range_ != nullptr) {
         const std::vector<float>& fr = *free_range_;
         const float edge = fr[hal::free_range_bin(std::atan2(b.y, b.x), fr.size())];
         if (std::sqrt(b2) > static_cast<double>(edge) + pr.occlusion_margin) continue;

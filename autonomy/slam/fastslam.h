@@ -426,7 +426,7 @@ class FastSlam {
   std::vector<Particle> spare_;
   // scratch of update and update_particle (kept to spare the allocations)
   Frame frame_;
-  const std::vector<float>* free_range_ = nullptr;  // update()'s free-space boundary
+  const std::vector<float>* free_range_ = nullptr;  // update()'s free-space boundary, null if it hides nothing
   std::vector<double> log_lik_;
   std::vector<int> in_reach_;   // live blocks (positions) within reach
   std::vector<int> near_;       // the landmarks' indices, ascending
