@@ -14,6 +14,7 @@
 #include "sim/runner/scenario.h"
 #include "sim/runner/schema.h"
 #include "sim/runner/simulation.h"
+#include "sim/runner/sweep.h"
 #include "sim/runner/vehicle_report.h"
 #include "sim/world/track.h"
 
@@ -29,6 +30,12 @@ const char* kUsage =
     "      (DIR defaults to runs/<scenario name>). --json prints the summary as JSON;\n"
     "      --quiet prints only failed expectations; --plots also draws the figures.\n"
     "      Exit 3 when [expect] fails.\n"
+    "  paddock sweep SWEEP.ini [--jobs N] [--out DIR] [--resume]\n"
+    "      runs a sweep's points (scenarios x [vary] values x seeds) on N cores (default:\n"
+    "      all) into DIR (default runs/<sweep name>): DIR/points/NNNN/{scenario.ini,\n"
+    "      summary.json}, DIR/results.csv (one row per point), DIR/timing.csv.\n"
+    "      --resume runs only the points an interrupted sweep left. Exit 1 if a point\n"
+    "      failed to run, 130 if interrupted\n"
     "  paddock plot RUN_DIR [PLOT OPTIONS]\n"
     "      draws DIR/map.png, DIR/controller.png and DIR/laps.png from a finished\n"
     "      run's scenario.ini, log.csv and summary.json\n"
@@ -216,6 +223,26 @@ int cmd_plot(const std::vector<std::string>& args) {
   return 0;
 }
 
+int cmd_sweep(const std::vector<std::string>& args) {
+  std::string path;
+  SweepOptions o;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&](const char* flag) -> std::string {
+      if (i + 1 >= args.size()) throw UserError(std::string(flag) + " needs a value");
+      return args[++i];
+    };
+    if (a == "--jobs") o.jobs = option_int("--jobs", value("--jobs"), 1, 4096);
+    else if (a == "--out") o.out_dir = value("--out");
+    else if (a == "--resume") o.resume = true;
+    else if (!a.empty() && a[0] == '-') throw UserError("sweep: unknown option " + a + "\n" + kUsage);
+    else if (path.empty()) path = a;
+    else throw UserError("sweep: more than one sweep file given: " + path + " and " + a);
+  }
+  if (path.empty()) throw UserError(std::string("sweep needs a sweep file\n") + kUsage);
+  return run_sweep(path, o);
+}
+
 int cmd_check_track(const std::vector<std::string>& args) {
   if (args.empty()) throw UserError(std::string("check-track needs at least one file\n") + kUsage);
   int bad = 0;
@@ -244,6 +271,7 @@ int run_cli(const std::vector<std::string>& args) {
     if (args[0] == "run") return cmd_run(rest);
     if (args[0] == "check-track") return cmd_check_track(rest);
     if (args[0] == "plot") return cmd_plot(rest);
+    if (args[0] == "sweep") return cmd_sweep(rest);
     if (args[0] == "report") return cmd_report(rest);
     if (args[0] == "keys") {
       if (!rest.empty()) throw UserError("keys takes no arguments\n" + std::string(kUsage));

@@ -204,7 +204,11 @@ std::string Scenario::check() const {
 }
 
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides) {
-  std::vector<IniEntry> entries = read_ini_file(path);
+  return load_scenario_entries(read_ini_file(path), path, overrides);
+}
+
+Scenario load_scenario_entries(std::vector<IniEntry> entries, const std::string& path,
+                               const std::vector<std::string>& overrides) {
   // command-line overrides come last, so they win
   for (std::size_t i = 0; i < overrides.size(); ++i) entries.push_back(override_entry(overrides[i], static_cast<int>(i + 1)));
   Scenario s;

@@ -21,6 +21,7 @@
 #include "sim/world/track.h"
 #include "sim/world/venue.h"
 #include "autonomy/common/params.h"
+#include "sim/runner/ini.h"
 #include "sim/runner/schema.h"
 
 namespace paddock::runner {
@@ -177,6 +178,11 @@ struct Scenario {
 // reads, resolves includes, applies the overrides ("section.key=value"), checks
 // every key and value; throws UserError "file:line: ..." on any problem
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides = {});
+// the same from entries already read (a sweep's point: its base scenario's
+// entries, then the sweep's own); `path` names the scenario and its stem
+// the run
+Scenario load_scenario_entries(std::vector<IniEntry> entries, const std::string& path,
+                               const std::vector<std::string>& overrides = {});
 
 // a vehicle parameter file (scenarios/vehicles/default.ini's format: one
 // [vehicle] section, includes allowed) read with the scenario's keys and

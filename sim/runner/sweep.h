@@ -1,0 +1,107 @@
+#pragma once
+// paddock sweep: one scenario (or several) run over a set of parameter
+// values, on every core, into one folder with a results.csv.
+//
+// A sweep file is INI in the scenarios' dialect:
+//
+//   ; scenarios/sweeps/stanley_gain.ini
+//   [sweep]
+//   scenarios = ../fsg_2023_trackdrive.ini, ../fss_2019_trackdrive.ini
+//   combine = grid                 ; grid (every combination) or zip (i-th with i-th)
+//   seeds = 1..3                   ; each combination with each seed (default: the scenario's)
+//   samples = 20                   ; draws of the uniform()/loguniform() keys
+//   sampling = lhs                 ; random or lhs (Latin hypercube)
+//   sample_seed = 7
+//   [vary]
+//   control.stanley.k = linspace(1, 4, 4)          ; 1, 2, 3, 4
+//   control.lateral = stanley, combined            ; a list, as written
+//   planning.reference.profile.ay_max = logspace(4, 16, 3) ; 4, 8, 16 (geometric, ends included)
+//   control.longitudinal.kp = uniform(1, 3)        ; drawn, `samples` times
+//   control.combined.kappa_ref = loguniform(0.01, 1)
+//   event.timeout = 100..102                       ; whole numbers, ends included
+//   [autonomy]                     ; any other section: set for every point
+//   planner = oracle
+//
+// Without `scenarios` the sweep file is itself the base scenario (it
+// includes one, and its other sections change it). The points: for each
+// scenario, for each combination (grid: the listed keys' product, first key
+// slowest, times the samples; zip: the listed keys and the samples side by
+// side, all of one length), for each seed. A value goes into the scenario as
+// if written on its [vary] line, so a bad one is reported there.
+//
+// A sweep writes DIR/points/NNNN/{scenario.ini,summary.json} per point (as
+// `paddock run` writes them; summary.json last, so a point with one is done),
+// DIR/results.csv (one row per point, in point order, from the summaries:
+// the same whatever the number of jobs) and DIR/timing.csv (wall times,
+// which differ from run to run, kept apart). --resume reruns only the
+// points without a summary (an interrupted sweep: Ctrl-C, a killed job).
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sim/runner/ini.h"
+#include "sim/runner/scenario.h"
+
+namespace paddock::runner {
+
+struct SweepAxis {
+  enum class Kind { List, Uniform, LogUniform };
+  std::string section, key;  // the scenario key it varies
+  Kind kind = Kind::List;
+  std::vector<std::string> values;  // List: the values, as written or computed
+  double lo = 0.0, hi = 0.0;        // Uniform, LogUniform: the interval drawn from
+  IniEntry where;                   // its [vary] line
+  std::string name() const { return section + "." + key; }
+};
+
+struct SweepSpec {
+  std::string path;                    // the sweep file
+  std::string name;                    // its stem
+  std::vector<std::string> scenarios;  // the base scenarios' paths; empty: the sweep file itself
+  std::vector<IniEntry> common;        // the sweep file's entries outside [sweep] and [vary]
+  std::vector<SweepAxis> axes;         // in the file's order
+  bool zip = false;
+  bool latin_hypercube = false;
+  int samples = 0;
+  std::uint64_t sample_seed = 1;
+  std::vector<std::uint64_t> seeds;  // empty: each scenario's own seed
+  IniEntry seeds_where;
+};
+
+// reads and checks a sweep file; throws UserError "file:line: ..." on a bad one
+SweepSpec load_sweep(const std::string& path);
+
+struct SweepPoint {
+  int index = 0;
+  std::size_t scenario = 0;         // into SweepSpec::scenarios (0 when the file is the base)
+  std::vector<std::string> values;  // per axis, as the scenario gets it
+  std::optional<std::uint64_t> seed;
+};
+
+// every point, in order (see the top); throws UserError when the axes do not fit
+std::vector<SweepPoint> expand_sweep(const SweepSpec& spec);
+
+// the point's scenario, checked; throws UserError "sweep.ini:line: ..." for a
+// value the scenario refuses
+Scenario sweep_point_scenario(const SweepSpec& spec, const SweepPoint& point);
+
+struct SweepOptions {
+  std::string out_dir;  // empty: runs/<sweep name>
+  int jobs = 0;         // 0: every core
+  bool resume = false;
+};
+
+// runs the sweep and prints where its results are; returns the exit code:
+// 0 every point ran (a DNF is a result), 1 some point failed to run (its
+// error is in the table), 130 interrupted (--resume finishes it)
+int run_sweep(const std::string& path, const SweepOptions& options);
+
+// DIR/results.csv's text from the points' summaries (a point without one:
+// its error, or "not run")
+std::string sweep_results_csv(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::string& dir);
+
+// the folder of point i of n within a sweep's folder
+std::string sweep_point_dir(const std::string& dir, int index, std::size_t count);
+
+}  // namespace paddock::runner

@@ -1,0 +1,241 @@
+// paddock sweep: the sweep file's values and points against their
+// definitions (computed here), a Latin hypercube's strata by brute force,
+// file:line errors, and the command as a user runs it: the same results.csv
+// whatever the number of jobs, every row the figures of a plain `paddock run`
+// of the point's own resolved scenario, and --resume running only what is
+// missing.
+#include "sim/runner/sweep.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "sim/runner/files.h"
+#include "tests/runner/run_paddock.h"
+
+namespace paddock::runner {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const std::string kRoot = PADDOCK_SOURCE_DIR;
+
+std::string scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / "paddock_sweep_test" / name;
+  fs::remove_all(d);
+  fs::create_directories(d.parent_path());
+  return d.string();
+}
+
+// a sweep file in a scratch folder, naming scenarios by absolute path
+std::string sweep_file(const std::string& name, const std::string& text) {
+  const fs::path d = fs::temp_directory_path() / "paddock_sweep_test" / "files";
+  fs::create_directories(d);
+  const std::string path = (d / (name + ".ini")).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string expect_error(const std::string& text) {
+  const std::string path = sweep_file("bad", text);
+  try {
+    const SweepSpec spec = load_sweep(path);
+    const auto points = expand_sweep(spec);
+    for (const auto& p : points) sweep_point_scenario(spec, p);
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error for:\n" << text;
+  return "";
+}
+
+const std::string kAcc = "scenarios = " + kRoot + "/scenarios/acceleration.ini\n";
+
+TEST(Sweep, ValuesFollowTheirDefinitions) {
+  const SweepSpec s = load_sweep(sweep_file("values", "[sweep]\n" + kAcc +
+                                                          "[vary]\n"
+                                                          "control.stanley.k = linspace(0.5, 2, 4)\n"
+                                                          "control.combined.kappa_ref = logspace(0.01, 1, 3)\n"
+                                                          "event.timeout = 100..103\n"
+                                                          "control.lateral = stanley,  combined\n"));
+  ASSERT_EQ(s.axes.size(), 4u);
+  EXPECT_EQ(s.axes[0].values, (std::vector<std::string>{"0.5", "1", "1.5", "2"}));
+  // geometric, the ends exact: 0.01, 0.1, 1 (the middle to a few ulp)
+  ASSERT_EQ(s.axes[1].values.size(), 3u);
+  EXPECT_EQ(s.axes[1].values[0], "0.01");
+  EXPECT_NEAR(std::stod(s.axes[1].values[1]), 0.1, 1e-15);
+  EXPECT_EQ(s.axes[1].values[2], "1");
+  EXPECT_EQ(s.axes[2].values, (std::vector<std::string>{"100", "101", "102", "103"}));
+  EXPECT_EQ(s.axes[3].values, (std::vector<std::string>{"stanley", "combined"}));
+  EXPECT_EQ(s.axes[3].where.line, 7);
+}
+
+TEST(Sweep, GridZipAndSeedsGiveEveryPointOnceInOrder) {
+  const std::string head = "[sweep]\nscenarios = " + kRoot + "/scenarios/acceleration.ini, " + kRoot +
+                           "/scenarios/skidpad.ini\nseeds = 3..4\n";
+  const SweepSpec g = load_sweep(sweep_file("grid", head + "[vary]\ncontrol.stanley.k = 1, 2, 3\ncontrol.lateral = stanley, combined\n"));
+  const auto pg = expand_sweep(g);
+  // scenarios x (3 x 2) x seeds, scenario slowest, then the first key, the seed fastest
+  ASSERT_EQ(pg.size(), 2u * 6u * 2u);
+  std::set<std::tuple<std::size_t, std::string, std::string, std::uint64_t>> seen;
+  for (std::size_t i = 0; i < pg.size(); ++i) {
+    const SweepPoint& p = pg[i];
+    EXPECT_EQ(p.index, static_cast<int>(i));
+    EXPECT_EQ(p.scenario, i / 12);
+    EXPECT_EQ(p.values[0], std::to_string(i / 4 % 3 + 1));
+    EXPECT_EQ(p.values[1], i / 2 % 2 == 0 ? "stanley" : "combined");
+    ASSERT_TRUE(p.seed.has_value());
+    EXPECT_EQ(*p.seed, 3u + i % 2);
+    seen.insert({p.scenario, p.values[0], p.values[1], *p.seed});
+  }
+  EXPECT_EQ(seen.size(), pg.size());
+
+  const SweepSpec z = load_sweep(sweep_file("zip", "[sweep]\n" + kAcc + "combine = zip\n[vary]\ncontrol.stanley.k = 1, 2, 3\ncontrol.lateral = stanley, combined, pure_pursuit\n"));
+  const auto pz = expand_sweep(z);
+  ASSERT_EQ(pz.size(), 3u);
+  EXPECT_EQ(pz[2].values, (std::vector<std::string>{"3", "pure_pursuit"}));
+  EXPECT_FALSE(pz[0].seed.has_value());
+  // the value reaches the scenario
+  const Scenario sc = sweep_point_scenario(z, pz[1]);
+  EXPECT_EQ(sc.control.stanley.k, 2.0);
+  EXPECT_EQ(sc.control.lateral, control::LateralMode::Combined);
+}
+
+TEST(Sweep, LatinHypercubeDrawsEachStratumOnceRandomStaysInBounds) {
+  const std::string text = "[sweep]\n" + kAcc +
+                           "samples = 50\nsampling = lhs\nsample_seed = 9\n[vary]\n"
+                           "control.stanley.k = uniform(1, 3)\ncontrol.combined.kappa_ref = loguniform(0.01, 1)\n";
+  const SweepSpec s = load_sweep(sweep_file("lhs", text));
+  const auto p = expand_sweep(s);
+  ASSERT_EQ(p.size(), 50u);
+  std::set<int> strata_k, strata_kappa;
+  for (const SweepPoint& q : p) {
+    const double k = std::stod(q.values[0]), kappa = std::stod(q.values[1]);
+    // stratum of each draw: linear for uniform, in log for loguniform
+    strata_k.insert(static_cast<int>(std::floor((k - 1.0) / 2.0 * 50.0)));
+    strata_kappa.insert(static_cast<int>(std::floor((std::log(kappa) - std::log(0.01)) / (std::log(1.0) - std::log(0.01)) * 50.0)));
+  }
+  EXPECT_EQ(strata_k.size(), 50u) << "each of the 50 strata of k once";
+  EXPECT_EQ(strata_kappa.size(), 50u);
+  EXPECT_EQ(*strata_k.begin(), 0);
+  EXPECT_EQ(*strata_k.rbegin(), 49);
+  // the same seed draws the same values; another seed others
+  EXPECT_EQ(expand_sweep(load_sweep(sweep_file("lhs2", text)))[7].values, p[7].values);
+  std::string other = text;
+  other.replace(other.find("sample_seed = 9"), 15, "sample_seed = 8");
+  EXPECT_NE(expand_sweep(load_sweep(sweep_file("lhs3", other)))[7].values, p[7].values);
+
+  std::string random = text;
+  random.replace(random.find("sampling = lhs"), 14, "sampling = random");
+  const auto r = expand_sweep(load_sweep(sweep_file("random", random)));
+  ASSERT_EQ(r.size(), 50u);
+  std::set<std::string> distinct;
+  for (const SweepPoint& q : r) {
+    const double k = std::stod(q.values[0]), kappa = std::stod(q.values[1]);
+    EXPECT_GE(k, 1.0);
+    EXPECT_LE(k, 3.0);
+    EXPECT_GE(kappa, 0.01);
+    EXPECT_LE(kappa, 1.0);
+    distinct.insert(q.values[0]);
+  }
+  EXPECT_EQ(distinct.size(), 50u);
+}
+
+TEST(Sweep, BadFilesAreFileLineErrors) {
+  EXPECT_THAT(expect_error("[sweep]\n" + kAcc + "[vary]\ncontrol.stanley.k = linspace(1, 2)\n"),
+              HasSubstr("bad.ini:4: linspace(first, last, count) takes 3 numbers"));
+  EXPECT_THAT(expect_error("[sweep]\n" + kAcc + "[vary]\ncontrol.stanley.k = logspace(0, 2, 3)\n"),
+              HasSubstr("bad.ini:4: logspace(first, last, count): first and last must be > 0"));
+  EXPECT_THAT(expect_error("[sweep]\n" + kAcc + "combine = product\n"), HasSubstr("bad.ini:3: combine: expected grid or zip"));
+  EXPECT_THAT(expect_error("[sweep]\n" + kAcc + "seed = 1\n"), HasSubstr("bad.ini:3: [sweep] unknown key 'seed'"));
+  EXPECT_THAT(expect_error("[sweep]\n" + kAcc + "seeds = 5..2\n"), HasSubstr("bad.ini:3: seeds: expected whole numbers"));
+  EXPECT_THAT(expect_error("[sweep]\n" + kAcc + "[vary]\ncontrol.stanley.k = uniform(1, 2)\n"),
+              HasSubstr("samples is not set"));
+  EXPECT_THAT(expect_error("[sweep]\n" + kAcc + "combine = zip\n[vary]\ncontrol.stanley.k = 1, 2\ncontrol.lateral = stanley\n"),
+              HasSubstr("bad.ini:6: combine = zip: control.lateral has 1 values, but control.stanley.k has 2"));
+  // a value the scenario refuses is reported on its [vary] line
+  EXPECT_THAT(expect_error("[sweep]\n" + kAcc + "[vary]\ncontrol.lateral = stanley, lqr\n"),
+              HasSubstr("bad.ini:4: [control] lateral = 'lqr' is not known"));
+  EXPECT_THAT(expect_error("[sweep]\n" + kAcc + "[vary]\ncontrol.stanly.k = 1\n"), HasSubstr("bad.ini:4: unknown section [control.stanly]"));
+  EXPECT_THAT(expect_error("[sweep]\nscenarios = nowhere.ini\n"), HasSubstr("nowhere.ini"));
+}
+
+// ---- the command
+
+std::string read(const std::string& p) { return read_file(p); }
+
+std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::vector<std::string> r;
+    std::stringstream ls(line);
+    std::string c;
+    while (std::getline(ls, c, ',')) r.push_back(c);
+    if (!line.empty() && line.back() == ',') r.push_back("");
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+TEST(Sweep, SameResultsWhateverTheJobsAndEachRowIsAPlainRunsFigures) {
+  // acceleration runs on the raw sensors and the full stack: 2 gains x 2 seeds
+  const std::string f = sweep_file("acc", "[sweep]\n" + kAcc + "seeds = 1..2\n[vary]\ncontrol.longitudinal.kp = 1.5, 2.5\n");
+  const std::string one = scratch("jobs1"), two = scratch("jobs2");
+  const auto a = testing::run_paddock("sweep " + f + " --jobs 1 --out " + one);
+  ASSERT_EQ(a.code, 0) << a.output;
+  const auto b = testing::run_paddock("sweep " + f + " --jobs 2 --out " + two);
+  ASSERT_EQ(b.code, 0) << b.output;
+  const std::string table = read(one + "/results.csv");
+  EXPECT_EQ(table, read(two + "/results.csv")) << "results.csv differs between --jobs 1 and --jobs 2";
+  const auto rows = csv_rows(table);
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[0][2], "control.longitudinal.kp");
+  EXPECT_EQ(rows[0][3], "seed");
+  EXPECT_EQ(rows[0][10], "total_time_s");
+  // point 3: kp 2.5, seed 2; its own scenario run by hand gives its row's figures
+  EXPECT_EQ(rows[4][2], "2.5");
+  EXPECT_EQ(rows[4][3], "2");
+  const std::string point = two + "/points/0003";
+  const std::string again = scratch("again");
+  const auto c = testing::run_paddock("run " + point + "/scenario.ini --json --out " + again);
+  ASSERT_EQ(c.code, 0) << c.output;
+  EXPECT_THAT(c.output, HasSubstr("\"total_time\":" + rows[4][10]));
+  EXPECT_EQ(rows[4][4], "true");
+  // the seeds differ, so do the runs
+  EXPECT_NE(rows[3][10] + rows[3][15], rows[4][10] + rows[4][15]);
+}
+
+TEST(Sweep, ResumeRunsOnlyWhatIsMissingAndRefusesAChangedSweep) {
+  const std::string f = sweep_file("resume", "[sweep]\n" + kAcc + "[vary]\ncontrol.longitudinal.kp = 1.5, 2, 2.5\n");
+  const std::string dir = scratch("resume");
+  ASSERT_EQ(testing::run_paddock("sweep " + f + " --out " + dir).code, 0);
+  const std::string full = read(dir + "/results.csv");
+  const auto kept = fs::last_write_time(dir + "/points/0000/summary.json");
+  fs::remove(dir + "/points/0001/summary.json");  // as if killed while running it
+  const auto again = testing::run_paddock("sweep " + f + " --out " + dir);
+  EXPECT_EQ(again.code, 2);
+  EXPECT_THAT(again.output, HasSubstr("holds a sweep already: --resume"));
+  const auto r = testing::run_paddock("sweep " + f + " --resume --out " + dir);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("1 of 1 points run"));
+  EXPECT_EQ(fs::last_write_time(dir + "/points/0000/summary.json"), kept);
+  EXPECT_EQ(read(dir + "/results.csv"), full);
+  // the file changed under the folder: refused, not mixed
+  std::ofstream(f) << "[sweep]\n" + kAcc + "[vary]\ncontrol.longitudinal.kp = 1.5, 2, 3\n";
+  fs::remove(dir + "/points/0002/summary.json");
+  std::ofstream(f, std::ios::app) << "[control]\nlateral = stanley\n";
+  const auto changed = testing::run_paddock("sweep " + f + " --resume --out " + dir);
+  EXPECT_EQ(changed.code, 2);
+  EXPECT_THAT(changed.output, HasSubstr("points/0000: this point's scenario differs"));
+}
+
+}  // namespace
+}  // namespace paddock::runner
