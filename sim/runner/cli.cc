@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <tuple>
 #include <iostream>
 
 #include "autonomy/common/format.h"
@@ -30,12 +31,19 @@ const char* kUsage =
     "      (DIR defaults to runs/<scenario name>). --json prints the summary as JSON;\n"
     "      --quiet prints only failed expectations; --plots also draws the figures.\n"
     "      Exit 3 when [expect] fails.\n"
-    "  paddock sweep SWEEP.ini [--jobs N] [--out DIR] [--resume]\n"
+    "  paddock sweep SWEEP.ini [--jobs N] [--out DIR] [--resume] [--shard i/n]\n"
     "      runs a sweep's points (scenarios x [vary] values x seeds) on N cores (default:\n"
     "      all) into DIR (default runs/<sweep name>): DIR/points/NNNN/{scenario.ini,\n"
     "      summary.json}, DIR/results.csv (one row per point), DIR/timing.csv.\n"
-    "      --resume runs only the points an interrupted sweep left. Exit 1 if a point\n"
-    "      failed to run, 130 if interrupted\n"
+    "      --resume runs only the points an interrupted sweep left; --shard runs the\n"
+    "      i-th of n slices of the points (a Slurm task). Exit 1 if a point failed to\n"
+    "      run, 130 if interrupted\n"
+    "  paddock sweep SWEEP.ini --slurm [--partition P] [--time T] [--array-limit K]\n"
+    "              [--tasks N] [--cpus-per-task C] [--sbatch-arg ARG]... [--dry-run | --wait]\n"
+    "      writes DIR/slurm/sweep.sbatch (an array job, one shard per task) and submits\n"
+    "      it with sbatch; --wait waits for it and collects\n"
+    "  paddock sweep collect DIR\n"
+    "      DIR/results.csv and timing.csv from the points' summaries (after Slurm)\n"
     "  paddock plot RUN_DIR [PLOT OPTIONS]\n"
     "      draws DIR/map.png, DIR/controller.png and DIR/laps.png from a finished\n"
     "      run's scenario.ini, log.csv and summary.json\n"
@@ -223,9 +231,30 @@ int cmd_plot(const std::vector<std::string>& args) {
   return 0;
 }
 
+// "i/n" with 0 <= i < n
+std::pair<int, int> shard_of(const std::string& v) {
+  const auto slash = v.find('/');
+  if (slash != std::string::npos) {
+    char* e1 = nullptr;
+    char* e2 = nullptr;
+    const std::string a = v.substr(0, slash), b = v.substr(slash + 1);
+    const long i = std::strtol(a.c_str(), &e1, 10), n = std::strtol(b.c_str(), &e2, 10);
+    if (!a.empty() && !b.empty() && *e1 == '\0' && *e2 == '\0' && n >= 1 && n <= 100000 && i >= 0 && i < n) {
+      return {static_cast<int>(i), static_cast<int>(n)};
+    }
+  }
+  throw UserError("--shard " + v + ": expected i/n with 0 <= i < n (e.g. 3/10)");
+}
+
 int cmd_sweep(const std::vector<std::string>& args) {
+  if (!args.empty() && args[0] == "collect") {
+    if (args.size() != 2) throw UserError(std::string("sweep collect needs one sweep folder\n") + kUsage);
+    return collect_sweep(args[1]);
+  }
   std::string path;
   SweepOptions o;
+  SlurmOptions slurm;
+  bool use_slurm = false, slurm_option = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&](const char* flag) -> std::string {
@@ -235,11 +264,29 @@ int cmd_sweep(const std::vector<std::string>& args) {
     if (a == "--jobs") o.jobs = option_int("--jobs", value("--jobs"), 1, 4096);
     else if (a == "--out") o.out_dir = value("--out");
     else if (a == "--resume") o.resume = true;
+    else if (a == "--shard") std::tie(o.shard, o.shards) = shard_of(value("--shard"));
+    else if (a == "--slurm") use_slurm = true;
+    else if (a == "--partition" || a == "--time" || a == "--array-limit" || a == "--tasks" || a == "--cpus-per-task" ||
+             a == "--sbatch-arg" || a == "--dry-run" || a == "--wait") {
+      slurm_option = true;
+      if (a == "--partition") slurm.partition = value("--partition");
+      else if (a == "--time") slurm.time = value("--time");
+      else if (a == "--array-limit") slurm.array_limit = option_int(a, value("--array-limit"), 1, 100000);
+      else if (a == "--tasks") slurm.tasks = option_int(a, value("--tasks"), 1, 100000);
+      else if (a == "--cpus-per-task") slurm.cpus_per_task = option_int(a, value("--cpus-per-task"), 1, 4096);
+      else if (a == "--sbatch-arg") slurm.sbatch_args.push_back(value("--sbatch-arg"));
+      else if (a == "--dry-run") slurm.dry_run = true;
+      else slurm.wait = true;
+    }
     else if (!a.empty() && a[0] == '-') throw UserError("sweep: unknown option " + a + "\n" + kUsage);
     else if (path.empty()) path = a;
     else throw UserError("sweep: more than one sweep file given: " + path + " and " + a);
   }
   if (path.empty()) throw UserError(std::string("sweep needs a sweep file\n") + kUsage);
+  if (slurm_option && !use_slurm) throw UserError("sweep: --partition, --time, --array-limit, --tasks, --cpus-per-task, --sbatch-arg, --dry-run and --wait go with --slurm");
+  if (use_slurm && o.shards > 0) throw UserError("sweep: --slurm and --shard do not go together (each Slurm task runs a shard)");
+  if (use_slurm && slurm.dry_run && slurm.wait) throw UserError("sweep: --dry-run and --wait do not go together");
+  if (use_slurm) o.slurm = slurm;
   return run_sweep(path, o);
 }
 

@@ -1,5 +1,6 @@
 #include "sim/runner/sweep.h"
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -483,27 +484,90 @@ Scenario sweep_point_scenario(const SweepSpec& spec, const SweepPoint& point) {
   return load_scenario_entries(entries, base);
 }
 
-std::string sweep_point_dir(const std::string& dir, int index, std::size_t count) {
-  const int width = std::max<int>(4, static_cast<int>(std::to_string(count > 0 ? count - 1 : 0).size()));
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%0*d", width, index);
-  return (fs::path(dir) / "points" / buf).string();
+namespace {
+
+// one CSV line's cells (quotes as `cell` writes them)
+std::vector<std::string> csv_cells(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        out.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        out.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
 }
 
-std::string sweep_results_csv(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::string& dir) {
+// DIR/points.csv: the points, with the seed each one runs with
+std::string manifest_csv(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::vector<Scenario>& scenarios) {
   std::ostringstream o;
   o << "point,scenario";
   for (const SweepAxis& a : spec.axes) o << "," << cell(a.name());
-  o << ",seed";
+  o << ",seed\n";
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    o << points[i].index << "," << cell(scenarios[i].name);
+    for (const std::string& v : points[i].values) o << "," << cell(v);
+    o << "," << scenarios[i].scenario.seed << "\n";
+  }
+  return o.str();
+}
+
+struct Manifest {
+  std::string header;                      // the line as written
+  std::vector<std::string> lines;          // one per point, as written
+  std::vector<int> index;                  // each line's point
+};
+
+Manifest read_manifest(const std::string& dir) {
+  const std::string path = (fs::path(dir) / "points.csv").string();
+  if (!fs::exists(path)) throw UserError(dir + ": no points.csv here: not a sweep's folder");
+  Manifest m;
+  std::istringstream in(read_file(path));
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (number == 1) {
+      if (line.rfind("point,scenario", 0) != 0) throw UserError(path + ":1: expected the header point,scenario,...");
+      m.header = line;
+      continue;
+    }
+    if (line.empty()) continue;
+    const auto p = whole(csv_cells(line).front());
+    if (!p || *p != static_cast<std::int64_t>(m.lines.size())) {
+      throw UserError(path + ":" + std::to_string(number) + ": expected point " + std::to_string(m.lines.size()));
+    }
+    m.lines.push_back(line);
+    m.index.push_back(static_cast<int>(*p));
+  }
+  return m;
+}
+
+}  // namespace
+
+std::string sweep_results_csv(const std::string& dir) {
+  const Manifest m = read_manifest(dir);
+  std::ostringstream o;
+  o << m.header;
   for (const char* c : kFigureColumns) o << "," << c;
   o << "\n";
-  for (const SweepPoint& p : points) {
-    const std::string pd = sweep_point_dir(dir, p.index, points.size());
-    const std::string base = spec.scenarios.empty() ? spec.path : spec.scenarios[p.scenario];
-    o << p.index << "," << cell(fs::path(base).stem().string());
-    for (const std::string& v : p.values) o << "," << cell(v);
+  for (std::size_t i = 0; i < m.lines.size(); ++i) {
+    const std::string pd = sweep_point_dir(dir, m.index[i], m.lines.size());
     std::vector<std::string> figures;
-    std::string seed = p.seed ? std::to_string(*p.seed) : "";
     if (fs::exists(pd + "/summary.json")) {
       const nlohmann::json s = nlohmann::json::parse(read_file(pd + "/summary.json"), nullptr, false);
       if (s.is_discarded()) {
@@ -511,44 +575,191 @@ std::string sweep_results_csv(const SweepSpec& spec, const std::vector<SweepPoin
         figures.back() = pd + "/summary.json: not valid JSON";
       } else {
         figures = figures_of(s);
-        if (s.contains("seed") && s["seed"].is_number_unsigned()) seed = std::to_string(s["seed"].get<std::uint64_t>());
       }
     } else {
       figures.assign(std::size(kFigureColumns), "");
       figures.back() = fs::exists(pd + "/error.txt") ? trim(read_file(pd + "/error.txt")) : "not run";
     }
-    o << "," << seed;
+    o << m.lines[i];
     for (const std::string& f : figures) o << "," << cell(f);
     o << "\n";
   }
   return o.str();
 }
 
+int collect_sweep(const std::string& dir) {
+  const Manifest m = read_manifest(dir);
+  write_file_atomic(dir + "/results.csv", sweep_results_csv(dir));
+  std::string timing = "point,wall_time_s\n";
+  std::vector<int> missing;
+  for (std::size_t i = 0; i < m.lines.size(); ++i) {
+    const std::string pd = sweep_point_dir(dir, m.index[i], m.lines.size());
+    if (!fs::exists(pd + "/summary.json")) {
+      missing.push_back(m.index[i]);
+      continue;
+    }
+    const nlohmann::json s = nlohmann::json::parse(read_file(pd + "/summary.json"), nullptr, false);
+    timing += std::to_string(m.index[i]) + "," + (s.is_discarded() ? std::string() : num(s, "wall_time")) + "\n";
+  }
+  write_file_atomic(dir + "/timing.csv", timing);
+  std::cout << "  results     " << dir << "/results.csv (" << m.lines.size() - missing.size() << " of " << m.lines.size()
+            << " points done)\n";
+  if (!missing.empty()) {
+    std::string list;
+    for (std::size_t k = 0; k < missing.size() && k < 20; ++k) list += (k ? ", " : "") + std::to_string(missing[k]);
+    if (missing.size() > 20) list += ", ...";
+    std::cout << "  missing     " << missing.size() << " points without a summary: " << list
+              << " (their error, if any, is in results.csv)\n";
+  }
+  return missing.empty() ? 0 : 1;
+}
+
+std::string sweep_point_dir(const std::string& dir, int index, std::size_t count) {
+  const int width = std::max<int>(4, static_cast<int>(std::to_string(count > 0 ? count - 1 : 0).size()));
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%0*d", width, index);
+  return (fs::path(dir) / "points" / buf).string();
+}
+
+std::pair<std::size_t, std::size_t> sweep_shard(std::size_t points, int i, int n) {
+  const auto a = static_cast<std::size_t>(i) * points / static_cast<std::size_t>(n);
+  const auto b = static_cast<std::size_t>(i + 1) * points / static_cast<std::size_t>(n);
+  return {a, b};
+}
+
+namespace {
+
+// a word for a shell script, single-quoted
+std::string shell_word(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) {
+    if (c == '\'') q += "'\\''";
+    else q += c;
+  }
+  return q + "'";
+}
+
+// runs a command, returns its exit status and its standard output
+std::pair<int, std::string> capture(const std::string& command) {
+  std::string out;
+  FILE* p = popen(command.c_str(), "r");
+  if (!p) return {-1, ""};
+  char buf[4096];
+  std::size_t n;
+  while ((n = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+  const int status = pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+std::string self_binary() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw UserError("cannot find the paddock binary (/proc/self/exe): " + ec.message());
+  return p.string();
+}
+
+int submit_to_slurm(const SweepSpec& spec, std::size_t points, const std::string& dir, const SlurmOptions& o) {
+  const int tasks = static_cast<int>(std::min<std::size_t>(points, o.tasks > 0 ? static_cast<std::size_t>(o.tasks) : 100));
+  const std::string abs_dir = fs::absolute(dir).lexically_normal().string();
+  const std::string abs_sweep = fs::absolute(spec.path).lexically_normal().string();
+  std::ostringstream sc;
+  sc << "#!/bin/bash\n"
+     << "# paddock sweep " << spec.name << " on Slurm: " << points << " points in " << tasks
+     << " array tasks, each one shard (paddock sweep --shard i/n) into the same folder.\n"
+     << "# When every task is done: " << self_binary() << " sweep collect " << shell_word(abs_dir) << "\n"
+     << "#SBATCH --job-name=paddock-" << spec.name << "\n"
+     << "#SBATCH --array=0-" << tasks - 1 << (o.array_limit > 0 ? "%" + std::to_string(o.array_limit) : "") << "\n"
+     << "#SBATCH --cpus-per-task=" << o.cpus_per_task << "\n"
+     << "#SBATCH --output=" << abs_dir << "/slurm/task_%a.out\n";
+  if (!o.partition.empty()) sc << "#SBATCH --partition=" << o.partition << "\n";
+  if (!o.time.empty()) sc << "#SBATCH --time=" << o.time << "\n";
+  for (const std::string& a : o.sbatch_args) sc << "#SBATCH " << a << "\n";
+  sc << "exec " << shell_word(self_binary()) << " sweep " << shell_word(abs_sweep) << " --out " << shell_word(abs_dir)
+     << " --shard \"$SLURM_ARRAY_TASK_ID/" << tasks << "\" --jobs \"${SLURM_CPUS_PER_TASK:-" << o.cpus_per_task << "}\"\n";
+  const std::string script = abs_dir + "/slurm/sweep.sbatch";
+  write_file_atomic(script, sc.str());
+  fs::permissions(script, fs::perms::owner_exec | fs::perms::group_exec | fs::perms::others_exec, fs::perm_options::add);
+  std::cout << "sweep " << spec.name << ": " << points << " points in " << tasks << " Slurm array tasks\n"
+            << "  script      " << script << "\n";
+  if (o.dry_run) {
+    std::cout << "  (--dry-run: not submitted; submit with: sbatch " << script << ")\n";
+    return 0;
+  }
+  const auto [rc, out] = capture("sbatch --parsable " + shell_word(script) + " 2>&1");
+  const std::string job = trim(out.substr(0, out.find_first_of(";\n")));
+  if (rc != 0 || !whole(job)) throw UserError("sbatch failed (exit " + std::to_string(rc) + "): " + trim(out));
+  write_file_atomic(abs_dir + "/slurm/job_id", job + "\n");
+  std::cout << "  submitted   job " << job << "\n";
+  if (!o.wait) {
+    std::cout << "  when it is done: paddock sweep collect " << dir << "\n";
+    return 0;
+  }
+  // wait for the array to leave the queue (squeue lists pending and running
+  // tasks only), showing how many points have their summary
+  std::size_t last = static_cast<std::size_t>(-1);
+  const bool tty = isatty(fileno(stderr)) != 0;
+  while (true) {
+    const auto [qrc, q] = capture("squeue -h -j " + job + " -o %i 2>/dev/null");
+    std::size_t done = 0;
+    for (std::size_t i = 0; i < points; ++i) done += fs::exists(sweep_point_dir(abs_dir, static_cast<int>(i), points) + "/summary.json");
+    if (done != last) {
+      if (tty) std::cerr << "\rslurm job " << job << ": " << done << "/" << points << " points done   " << std::flush;
+      else std::cerr << "slurm job " << job << ": " << done << "/" << points << " points done\n";
+      last = done;
+    }
+    if (qrc == 0 && trim(q).empty()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  }
+  if (tty) std::cerr << "\n";
+  return collect_sweep(dir);
+}
+
+}  // namespace
+
 int run_sweep(const std::string& path, const SweepOptions& options) {
   const SweepSpec spec = load_sweep(path);
   const std::vector<SweepPoint> points = expand_sweep(spec);
   const std::string dir = options.out_dir.empty() ? (fs::path("runs") / spec.name).string() : options.out_dir;
+  const bool shard = options.shards > 0;
 
   // every point's scenario first: a bad value stops the sweep before it starts
   std::vector<Scenario> scenarios;
   scenarios.reserve(points.size());
   for (const SweepPoint& p : points) scenarios.push_back(sweep_point_scenario(spec, p));
+
+  // a fresh folder (or --resume, or a shard of a sweep whose tasks share it)
+  const bool exists = fs::exists(fs::path(dir) / "points.csv");
+  if (exists && !options.resume && !shard) {
+    throw UserError(dir + " holds a sweep already: --resume to finish it, or --out another folder");
+  }
+  const std::string manifest = manifest_csv(spec, points, scenarios);
+  if (exists && read_file(dir + "/points.csv") != manifest) {
+    throw UserError(dir + "/points.csv: its points differ from what " + path +
+                    " gives now: the sweep file changed; run it into another folder (--out)");
+  }
+  if (!shard) {
+    write_file_atomic(dir + "/points.csv", manifest);
+    write_file_atomic(dir + "/sweep.ini", read_file(path));
+  } else if (!exists) {
+    throw UserError(dir + ": no points.csv here: a shard runs in the folder its sweep was submitted to");
+  }
+  if (options.slurm) return submit_to_slurm(spec, points.size(), dir, *options.slurm);
+
   // the tracks, loaded once and shared by the workers (read only)
+  const auto [first, last] = shard ? sweep_shard(points.size(), options.shard, options.shards)
+                                   : std::pair<std::size_t, std::size_t>{0, points.size()};
   std::map<std::string, std::shared_ptr<const world::TrackModel>> tracks;
-  for (const Scenario& s : scenarios) {
+  for (std::size_t i = first; i < last; ++i) {
+    const Scenario& s = scenarios[i];
     if (tracks.count(s.track_path)) continue;
     world::TrackFile file = load_track_file(s.track_path);
     for (const auto& w : file.warnings) std::cerr << "warning: " << w << "\n";
     tracks[s.track_path] = std::make_shared<const world::TrackModel>(world::build_track(file));
   }
 
-  // what is done already (--resume), and that it is this sweep's
+  // what is done already, and that it is this sweep's
   std::vector<std::size_t> todo;
-  const bool exists = fs::exists(fs::path(dir) / "points");
-  if (exists && !options.resume) {
-    throw UserError(dir + " holds a sweep already: --resume to finish it, or --out another folder");
-  }
-  for (std::size_t i = 0; i < points.size(); ++i) {
+  for (std::size_t i = first; i < last; ++i) {
     const std::string pd = sweep_point_dir(dir, points[i].index, points.size());
     if (fs::exists(pd + "/summary.json")) {
       if (!fs::exists(pd + "/scenario.ini") || read_file(pd + "/scenario.ini") != resolved_ini(scenarios[i])) {
@@ -559,21 +770,20 @@ int run_sweep(const std::string& path, const SweepOptions& options) {
     }
     todo.push_back(i);
   }
-  write_file_atomic(dir + "/sweep.ini", read_file(path));
 
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   const std::size_t jobs = std::min<std::size_t>(options.jobs > 0 ? static_cast<std::size_t>(options.jobs) : cores,
                                                  std::max<std::size_t>(todo.size(), 1));
   const bool tty = isatty(fileno(stderr)) != 0;
-  std::cerr << "sweep " << spec.name << ": " << points.size() << " points (" << points.size() - todo.size()
-            << " done before), " << jobs << (jobs == 1 ? " job" : " jobs") << ", into " << dir << "/\n";
+  std::cerr << "sweep " << spec.name << (shard ? " shard " + std::to_string(options.shard) + "/" + std::to_string(options.shards) : "")
+            << ": " << last - first << " points (" << last - first - todo.size() << " done before), " << jobs
+            << (jobs == 1 ? " job" : " jobs") << ", into " << dir << "/\n";
 
   g_interrupted = 0;
   const auto old_handler = std::signal(SIGINT, on_interrupt);
   std::mutex mu;
   std::atomic<std::size_t> next{0};
   std::size_t done = 0, failed = 0;
-  std::vector<std::pair<int, double>> walls;
   const auto start = std::chrono::steady_clock::now();
   const auto report = [&](const std::string& what) {
     // (under mu)
@@ -601,14 +811,12 @@ int run_sweep(const std::string& path, const SweepOptions& options) {
       const std::string pd = sweep_point_dir(dir, points[i].index, points.size());
       std::string what;
       bool ok = true;
-      double wall = 0.0;
       try {
         std::error_code ec;
         fs::remove(pd + "/error.txt", ec);
         const RunResult r = run(s, *tracks.at(s.track_path));
         write_file_atomic(pd + "/scenario.ini", resolved_ini(s));
         write_file_atomic(pd + "/summary.json", summary_json(s, r, check_expectations(s.expect, r)));
-        wall = r.wall_time;
         what = "point " + std::to_string(points[i].index) + ": " +
                (r.event.finished ? "finished, " + fixed(r.event.total_time, 3) + " s" : "DNF, " + r.event.dnf_reason);
       } catch (const std::exception& e) {
@@ -625,7 +833,6 @@ int run_sweep(const std::string& path, const SweepOptions& options) {
         ++failed;
         if (tty) std::cerr << "\n" << what << "\n";
       }
-      walls.emplace_back(points[i].index, wall);
       report(what);
     }
   };
@@ -635,31 +842,12 @@ int run_sweep(const std::string& path, const SweepOptions& options) {
   std::signal(SIGINT, old_handler);
   if (tty && !todo.empty()) std::cerr << "\n";
 
-  // the table, from every point's summary (also those of earlier runs)
-  write_file_atomic(dir + "/results.csv", sweep_results_csv(spec, points, dir));
-  std::string timing = "point,wall_time_s\n";
-  std::sort(walls.begin(), walls.end());
-  std::map<int, double> old_walls;
-  if (fs::exists(dir + "/timing.csv")) {
-    std::istringstream in(read_file(dir + "/timing.csv"));
-    std::string line;
-    std::getline(in, line);
-    while (std::getline(in, line)) {
-      const auto comma = line.find(',');
-      if (comma == std::string::npos) continue;
-      const auto p = whole(line.substr(0, comma));
-      const auto w = number(line.substr(comma + 1));
-      if (p && w) old_walls[static_cast<int>(*p)] = *w;
-    }
-  }
-  for (const auto& [p, w] : walls) old_walls[p] = w;
-  for (const auto& [p, w] : old_walls) timing += std::to_string(p) + "," + fmt(w) + "\n";
-  write_file_atomic(dir + "/timing.csv", timing);
-
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "sweep " << spec.name << ": " << done << " of " << todo.size() << " points run in " << fixed(elapsed, 1)
-            << " s (" << jobs << (jobs == 1 ? " job" : " jobs") << "), " << failed << " failed\n"
-            << "  results     " << dir << "/results.csv\n";
+            << " s (" << jobs << (jobs == 1 ? " job" : " jobs") << "), " << failed << " failed\n";
+  // the tables, from every point's summary (also those of earlier runs); a
+  // shard leaves them to `collect`, once every shard is done
+  if (!shard) collect_sweep(dir);
   if (g_interrupted) {
     std::cout << "  interrupted: " << todo.size() - done << " points not run; finish with --resume\n";
     return 130;

@@ -29,15 +29,20 @@
 // side, all of one length), for each seed. A value goes into the scenario as
 // if written on its [vary] line, so a bad one is reported there.
 //
-// A sweep writes DIR/points/NNNN/{scenario.ini,summary.json} per point (as
-// `paddock run` writes them; summary.json last, so a point with one is done),
-// DIR/results.csv (one row per point, in point order, from the summaries:
-// the same whatever the number of jobs) and DIR/timing.csv (wall times,
-// which differ from run to run, kept apart). --resume reruns only the
-// points without a summary (an interrupted sweep: Ctrl-C, a killed job).
+// A sweep writes DIR/points.csv (its points: index, scenario, values, seed),
+// DIR/points/NNNN/{scenario.ini,summary.json} per point (as `paddock run`
+// writes them; summary.json last, so a point with one is done),
+// DIR/results.csv (one row per point, in point order, from points.csv and the
+// summaries: the same whatever the number of jobs or machines) and
+// DIR/timing.csv (wall times, which differ from run to run, kept apart).
+// --resume reruns only the points without a summary (an interrupted sweep:
+// Ctrl-C, a killed job). On Slurm (--slurm) an array job's tasks each run a
+// shard (--shard i/n) into the same DIR, and `paddock sweep collect DIR`
+// writes the tables.
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim/runner/ini.h"
@@ -86,22 +91,45 @@ std::vector<SweepPoint> expand_sweep(const SweepSpec& spec);
 // value the scenario refuses
 Scenario sweep_point_scenario(const SweepSpec& spec, const SweepPoint& point);
 
+struct SlurmOptions {
+  std::string partition;       // --partition (empty: the cluster's default)
+  std::string time;            // --time limit per task (empty: the partition's)
+  int array_limit = 0;         // at most this many tasks at once (0: no limit)
+  int tasks = 0;               // array tasks (0: one per point, at most 100)
+  int cpus_per_task = 1;       // cores per task (its --jobs)
+  std::vector<std::string> sbatch_args;  // more sbatch options, verbatim
+  bool dry_run = false;        // write the script, do not submit
+  bool wait = false;           // wait for the job, then collect
+};
+
 struct SweepOptions {
   std::string out_dir;  // empty: runs/<sweep name>
   int jobs = 0;         // 0: every core
   bool resume = false;
+  int shard = -1, shards = 0;        // --shard i/n: only the i-th of n equal slices of the points
+  std::optional<SlurmOptions> slurm;  // --slurm: submit to Slurm instead of running here
 };
 
-// runs the sweep and prints where its results are; returns the exit code:
-// 0 every point ran (a DNF is a result), 1 some point failed to run (its
-// error is in the table), 130 interrupted (--resume finishes it)
+// runs the sweep (or its shard, or submits it to Slurm) and prints where its
+// results are; returns the exit code: 0 every point ran (a DNF is a result),
+// 1 some point failed to run (its error is in the table), 130 interrupted
+// (--resume finishes it)
 int run_sweep(const std::string& path, const SweepOptions& options);
 
-// DIR/results.csv's text from the points' summaries (a point without one:
-// its error, or "not run")
-std::string sweep_results_csv(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::string& dir);
+// paddock sweep collect DIR: results.csv and timing.csv from DIR/points.csv
+// and the points' summaries; 0 when every point has one, else 1 (the
+// missing ones are named)
+int collect_sweep(const std::string& dir);
+
+// DIR/results.csv's text: DIR/points.csv's rows (the point, its scenario, the
+// varied values, the seed) with the figures of each point's summary (a point
+// without one: its error, or "not run")
+std::string sweep_results_csv(const std::string& dir);
 
 // the folder of point i of n within a sweep's folder
 std::string sweep_point_dir(const std::string& dir, int index, std::size_t count);
+
+// the points of shard i of n: [i P / n, (i + 1) P / n)
+std::pair<std::size_t, std::size_t> sweep_shard(std::size_t points, int i, int n);
 
 }  // namespace paddock::runner

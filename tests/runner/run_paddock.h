@@ -13,9 +13,10 @@ struct Outcome {
   std::string output;  // stdout and stderr together
 };
 
-inline Outcome run_paddock(const std::string& args) {
+// any shell command, its standard output (add 2>&1 for the errors too)
+inline Outcome run_paddock_command(const std::string& command) {
   Outcome o;
-  FILE* p = popen((std::string(PADDOCK_BINARY) + " " + args + " 2>&1").c_str(), "r");
+  FILE* p = popen(command.c_str(), "r");
   if (!p) return o;
   std::array<char, 4096> buf{};
   std::size_t n;
@@ -23,6 +24,10 @@ inline Outcome run_paddock(const std::string& args) {
   const int status = pclose(p);
   o.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return o;
+}
+
+inline Outcome run_paddock(const std::string& args) {
+  return run_paddock_command(std::string(PADDOCK_BINARY) + " " + args + " 2>&1");
 }
 
 }  // namespace paddock::testing

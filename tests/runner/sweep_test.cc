@@ -9,7 +9,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -229,12 +232,112 @@ TEST(Sweep, ResumeRunsOnlyWhatIsMissingAndRefusesAChangedSweep) {
   EXPECT_EQ(fs::last_write_time(dir + "/points/0000/summary.json"), kept);
   EXPECT_EQ(read(dir + "/results.csv"), full);
   // the file changed under the folder: refused, not mixed
-  std::ofstream(f) << "[sweep]\n" + kAcc + "[vary]\ncontrol.longitudinal.kp = 1.5, 2, 3\n";
   fs::remove(dir + "/points/0002/summary.json");
   std::ofstream(f, std::ios::app) << "[control]\nlateral = stanley\n";
   const auto changed = testing::run_paddock("sweep " + f + " --resume --out " + dir);
   EXPECT_EQ(changed.code, 2);
   EXPECT_THAT(changed.output, HasSubstr("points/0000: this point's scenario differs"));
+  std::ofstream(f) << "[sweep]\n" + kAcc + "[vary]\ncontrol.longitudinal.kp = 1.5, 2, 3\n";
+  const auto values = testing::run_paddock("sweep " + f + " --resume --out " + dir);
+  EXPECT_EQ(values.code, 2);
+  EXPECT_THAT(values.output, HasSubstr("points.csv: its points differ"));
+}
+
+// ---- Slurm: a private single-node cluster (tools/slurm_private.sh: slurmctld,
+// slurmd and munged on loopback, state in a temporary folder), started and
+// stopped here; the sweep through it gives the local run's results.csv
+
+struct PrivateSlurm {
+  std::string dir, error;
+  PrivateSlurm() {
+    const std::string tool = kRoot + "/tools/slurm_private.sh";
+    if (std::system((tool + " check >/dev/null 2>&1").c_str()) != 0) {
+      error = "Slurm is not installed (Debian: slurm-wlm, munge; ./paddock test installs them)";
+      return;
+    }
+    char tmpl[] = "/tmp/paddock_slurm_XXXXXX";
+    if (!mkdtemp(tmpl)) {
+      error = "cannot make a temporary folder";
+      return;
+    }
+    dir = tmpl;
+    const auto o = testing::run_paddock_command(tool + " start " + dir + " 2>" + dir + "/start.log");
+    const std::string key = "export SLURM_CONF=";
+    const auto at = o.output.find(key);
+    if (o.code != 0 || at == std::string::npos) {
+      error = "the private Slurm did not start: " + o.output + read_file(dir + "/start.log");
+      return;
+    }
+    const std::string conf = o.output.substr(at + key.size(), o.output.find('\n', at) - at - key.size());
+    setenv("SLURM_CONF", conf.c_str(), 1);
+  }
+  ~PrivateSlurm() {
+    if (dir.empty()) return;
+    (void)std::system((kRoot + "/tools/slurm_private.sh stop " + dir + " >/dev/null 2>&1").c_str());
+    unsetenv("SLURM_CONF");
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+  }
+};
+
+TEST(Sweep, SlurmArrayJobGivesTheLocalResultsByteForByte) {
+  if (geteuid() != 0) GTEST_SKIP() << "the private Slurm runs its daemons as root (SlurmUser=root)";
+  const PrivateSlurm slurm;
+  if (!slurm.error.empty() && slurm.error.rfind("Slurm is not installed", 0) == 0) GTEST_SKIP() << slurm.error;
+  ASSERT_EQ(slurm.error, "");
+  const std::string f = sweep_file("slurm", "[sweep]\n" + kAcc + "seeds = 1..2\n[vary]\ncontrol.longitudinal.kp = 1.5, 2.5\n");
+  const std::string local = scratch("slurm_local"), cluster = scratch("slurm_cluster");
+  const auto a = testing::run_paddock("sweep " + f + " --jobs 2 --out " + local);
+  ASSERT_EQ(a.code, 0) << a.output;
+  // three array tasks for four points (shards of 1, 1 and 2 points), waited for and collected
+  const auto b = testing::run_paddock("sweep " + f + " --slurm --tasks 3 --wait --out " + cluster);
+  ASSERT_EQ(b.code, 0) << b.output;
+  EXPECT_THAT(b.output, HasSubstr("4 of 4 points done"));
+  EXPECT_THAT(read(cluster + "/slurm/sweep.sbatch"), HasSubstr("#SBATCH --array=0-2"));
+  for (int t = 0; t < 3; ++t) EXPECT_THAT(read(cluster + "/slurm/task_" + std::to_string(t) + ".out"), HasSubstr("shard " + std::to_string(t) + "/3"));
+  EXPECT_EQ(read(cluster + "/results.csv"), read(local + "/results.csv"));
+  // and collect again, by hand, gives the same
+  fs::remove(cluster + "/results.csv");
+  const auto c = testing::run_paddock("sweep collect " + cluster);
+  ASSERT_EQ(c.code, 0) << c.output;
+  EXPECT_EQ(read(cluster + "/results.csv"), read(local + "/results.csv"));
+}
+
+TEST(Sweep, ShardsSplitThePointsAndDryRunOnlyWritesTheScript) {
+  // every point in exactly one shard, in order, sizes within one
+  for (std::size_t p : {1u, 4u, 7u, 100u}) {
+    for (int n : {1, 2, 3, 7}) {
+      std::size_t next = 0, lo = p, hi = 0;
+      for (int i = 0; i < n; ++i) {
+        const auto [a, b] = sweep_shard(p, i, n);
+        EXPECT_EQ(a, next);
+        next = b;
+        lo = std::min(lo, b - a);
+        hi = std::max(hi, b - a);
+      }
+      EXPECT_EQ(next, p);
+      EXPECT_LE(hi - lo, 1u);
+    }
+  }
+  const std::string f = sweep_file("dry", "[sweep]\n" + kAcc + "[vary]\ncontrol.longitudinal.kp = 1, 2, 3\n");
+  const std::string dir = scratch("dry");
+  const auto o = testing::run_paddock("sweep " + f + " --slurm --dry-run --partition short --time 0:10:00 --array-limit 2 --out " + dir);
+  ASSERT_EQ(o.code, 0) << o.output;
+  const std::string script = read(dir + "/slurm/sweep.sbatch");
+  EXPECT_THAT(script, HasSubstr("#SBATCH --array=0-2%2"));
+  EXPECT_THAT(script, HasSubstr("#SBATCH --partition=short"));
+  EXPECT_THAT(script, HasSubstr("#SBATCH --time=0:10:00"));
+  EXPECT_THAT(script, HasSubstr("--shard \"$SLURM_ARRAY_TASK_ID/3\""));
+  EXPECT_FALSE(fs::exists(dir + "/points/0000"));
+  // a shard alone runs its slice only; collect names what is missing
+  const auto s1 = testing::run_paddock("sweep " + f + " --shard 1/3 --out " + dir);
+  ASSERT_EQ(s1.code, 0) << s1.output;
+  EXPECT_TRUE(fs::exists(dir + "/points/0001/summary.json"));
+  EXPECT_FALSE(fs::exists(dir + "/points/0000/summary.json"));
+  const auto c = testing::run_paddock("sweep collect " + dir);
+  EXPECT_EQ(c.code, 1);
+  EXPECT_THAT(c.output, HasSubstr("2 points without a summary: 0, 2"));
+  EXPECT_THAT(read(dir + "/results.csv"), HasSubstr(",not run\n"));
 }
 
 }  // namespace
