@@ -16,6 +16,7 @@
 #include "sim/runner/schema.h"
 #include "sim/runner/simulation.h"
 #include "sim/runner/sweep.h"
+#include "sim/runner/tune.h"
 #include "sim/runner/vehicle_report.h"
 #include "sim/world/track.h"
 
@@ -44,6 +45,10 @@ const char* kUsage =
     "      it with sbatch; --wait waits for it and collects\n"
     "  paddock sweep collect DIR\n"
     "      DIR/results.csv and timing.csv from the points' summaries (after Slurm)\n"
+    "  paddock tune TUNE.ini [--jobs N] [--out DIR] [--max-evals N]\n"
+    "      optimises the [optimise] keys within their bounds (NLopt) for the weighted\n"
+    "      total cost of the [tune] scenarios' runs; writes DIR/evaluations.csv and\n"
+    "      DIR/best.ini (DIR defaults to runs/<tune name>)\n"
     "  paddock plot RUN_DIR [PLOT OPTIONS]\n"
     "      draws DIR/map.png, DIR/controller.png and DIR/laps.png from a finished\n"
     "      run's scenario.ini, log.csv and summary.json\n"
@@ -290,6 +295,27 @@ int cmd_sweep(const std::vector<std::string>& args) {
   return run_sweep(path, o);
 }
 
+int cmd_tune(const std::vector<std::string>& args) {
+  std::string path;
+  TuneOptions o;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&](const char* flag) -> std::string {
+      if (i + 1 >= args.size()) throw UserError(std::string(flag) + " needs a value");
+      return args[++i];
+    };
+    if (a == "--jobs") o.jobs = option_int("--jobs", value("--jobs"), 1, 4096);
+    else if (a == "--out") o.out_dir = value("--out");
+    else if (a == "--max-evals") o.max_evals = option_int("--max-evals", value("--max-evals"), 1, 100000);
+    else if (!a.empty() && a[0] == '-') throw UserError("tune: unknown option " + a + "\n" + kUsage);
+    else if (path.empty()) path = a;
+    else throw UserError("tune: more than one tune file given: " + path + " and " + a);
+  }
+  if (path.empty()) throw UserError(std::string("tune needs a tune file\n") + kUsage);
+  run_tune(path, o);
+  return 0;
+}
+
 int cmd_check_track(const std::vector<std::string>& args) {
   if (args.empty()) throw UserError(std::string("check-track needs at least one file\n") + kUsage);
   int bad = 0;
@@ -319,6 +345,7 @@ int run_cli(const std::vector<std::string>& args) {
     if (args[0] == "check-track") return cmd_check_track(rest);
     if (args[0] == "plot") return cmd_plot(rest);
     if (args[0] == "sweep") return cmd_sweep(rest);
+    if (args[0] == "tune") return cmd_tune(rest);
     if (args[0] == "report") return cmd_report(rest);
     if (args[0] == "keys") {
       if (!rest.empty()) throw UserError("keys takes no arguments\n" + std::string(kUsage));

@@ -38,6 +38,8 @@ std::string trim(const std::string& s) {
   return s.substr(a, b - a + 1);
 }
 
+}  // namespace
+
 std::vector<std::string> split_list(const std::string& s) {
   std::vector<std::string> out;
   std::size_t start = 0;
@@ -49,6 +51,8 @@ std::vector<std::string> split_list(const std::string& s) {
   }
   return out;
 }
+
+namespace {
 
 // a finite number, the whole text
 std::optional<double> number(const std::string& s) {
@@ -160,7 +164,9 @@ SweepAxis parse_axis(const IniEntry& e) {
   return a;
 }
 
-std::vector<std::uint64_t> parse_seeds(const IniEntry& e) {
+}  // namespace
+
+std::vector<std::uint64_t> seed_list(const IniEntry& e) {
   std::vector<std::uint64_t> out;
   const std::string expected = ": seeds: expected whole numbers >= 0, as a list (1, 4, 9) or a range (1..5)";
   if (const auto r = int_range(e.value)) {
@@ -176,20 +182,18 @@ std::vector<std::uint64_t> parse_seeds(const IniEntry& e) {
   return out;
 }
 
-// the figures of a point's summary.json for its results.csv row
-struct Row {
-  std::vector<std::string> cells;
-};
+std::vector<std::string> scenario_list(const IniEntry& e) {
+  std::vector<std::string> out;
+  for (const std::string& s : split_list(e.value)) {
+    if (s.empty()) throw UserError(e.where() + ": scenarios: an empty file name in '" + e.value + "'");
+    const fs::path p(s);
+    out.push_back((p.is_absolute() ? p : fs::path(e.file).parent_path() / p).lexically_normal().string());
+  }
+  if (out.empty()) throw UserError(e.where() + ": scenarios: expected one scenario file or more");
+  return out;
+}
 
-const char* const kFigureColumns[] = {
-    "finished",       "dnf_reason",        "laps",         "best_lap_s",   "mean_lap_s",
-    "raw_time_s",     "total_time_s",      "doo",          "oc",           "uss",
-    "penalty_s",      "tracking_rms_m",    "tracking_max_m", "itae",       "ate_rms_m",
-    "ate_max_m",      "map_rmse_m",        "map_precision", "map_recall",  "perception_precision",
-    "perception_recall", "expectations_failed", "error"};
-
-// a CSV cell: quoted when it holds a comma, a quote or a line break
-std::string cell(const std::string& s) {
+std::string csv_cell(const std::string& s) {
   if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
   std::string q = "\"";
   for (char c : s) {
@@ -198,6 +202,17 @@ std::string cell(const std::string& s) {
   }
   return q + "\"";
 }
+
+namespace {
+
+// the figures of a point's summary.json for its results.csv row
+
+const char* const kFigureColumns[] = {
+    "finished",       "dnf_reason",        "laps",         "best_lap_s",   "mean_lap_s",
+    "raw_time_s",     "total_time_s",      "doo",          "oc",           "uss",
+    "penalty_s",      "tracking_rms_m",    "tracking_max_m", "itae",       "ate_rms_m",
+    "ate_max_m",      "map_rmse_m",        "map_precision", "map_recall",  "perception_precision",
+    "perception_recall", "expectations_failed", "error"};
 
 std::string num(const nlohmann::json& j, const char* key) {
   if (!j.is_object() || !j.contains(key) || !j[key].is_number()) return "";
@@ -292,16 +307,12 @@ SweepSpec load_sweep(const std::string& path) {
     }
     has_sweep = true;
     if (e.key == "scenarios") {
-      for (const std::string& s : split_list(e.value)) {
-        if (s.empty()) throw UserError(e.where() + ": scenarios: an empty file name in '" + e.value + "'");
-        const fs::path p(s);
-        spec.scenarios.push_back((p.is_absolute() ? p : fs::path(e.file).parent_path() / p).lexically_normal().string());
-      }
+      spec.scenarios = scenario_list(e);
     } else if (e.key == "combine") {
       if (e.value != "grid" && e.value != "zip") throw UserError(e.where() + ": combine: expected grid or zip, got '" + e.value + "'");
       spec.zip = e.value == "zip";
     } else if (e.key == "seeds") {
-      spec.seeds = parse_seeds(e);
+      spec.seeds = seed_list(e);
       spec.seeds_where = e;
     } else if (e.key == "samples") {
       const auto n = whole(e.value);
@@ -516,11 +527,11 @@ std::vector<std::string> csv_cells(const std::string& line) {
 std::string manifest_csv(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::vector<Scenario>& scenarios) {
   std::ostringstream o;
   o << "point,scenario";
-  for (const SweepAxis& a : spec.axes) o << "," << cell(a.name());
+  for (const SweepAxis& a : spec.axes) o << "," << csv_cell(a.name());
   o << ",seed\n";
   for (std::size_t i = 0; i < points.size(); ++i) {
-    o << points[i].index << "," << cell(scenarios[i].name);
-    for (const std::string& v : points[i].values) o << "," << cell(v);
+    o << points[i].index << "," << csv_cell(scenarios[i].name);
+    for (const std::string& v : points[i].values) o << "," << csv_cell(v);
     o << "," << scenarios[i].scenario.seed << "\n";
   }
   return o.str();
@@ -581,7 +592,7 @@ std::string sweep_results_csv(const std::string& dir) {
       figures.back() = fs::exists(pd + "/error.txt") ? trim(read_file(pd + "/error.txt")) : "not run";
     }
     o << m.lines[i];
-    for (const std::string& f : figures) o << "," << cell(f);
+    for (const std::string& f : figures) o << "," << csv_cell(f);
     o << "\n";
   }
   return o.str();

@@ -132,4 +132,14 @@ std::string sweep_point_dir(const std::string& dir, int index, std::size_t count
 // the points of shard i of n: [i P / n, (i + 1) P / n)
 std::pair<std::size_t, std::size_t> sweep_shard(std::size_t points, int i, int n);
 
+// shared by sweep and tune files:
+// "a, b, c" -> its trimmed items
+std::vector<std::string> split_list(const std::string& s);
+// `e`'s value as seeds: a list (1, 4, 9) or a range (1..5); throws UserError
+std::vector<std::uint64_t> seed_list(const IniEntry& e);
+// `e`'s value as scenario files, relative to the file it is written in
+std::vector<std::string> scenario_list(const IniEntry& e);
+// a CSV cell: quoted when it holds a comma, a quote or a line break
+std::string csv_cell(const std::string& s);
+
 }  // namespace paddock::runner
