@@ -16,6 +16,7 @@
 #include "sim/runner/schema.h"
 #include "sim/runner/simulation.h"
 #include "sim/runner/sweep.h"
+#include "sim/runner/sweep_report.h"
 #include "sim/runner/tune.h"
 #include "sim/runner/vehicle_report.h"
 #include "sim/world/track.h"
@@ -32,7 +33,7 @@ const char* kUsage =
     "      (DIR defaults to runs/<scenario name>). --json prints the summary as JSON;\n"
     "      --quiet prints only failed expectations; --plots also draws the figures.\n"
     "      Exit 3 when [expect] fails.\n"
-    "  paddock sweep SWEEP.ini [--jobs N] [--out DIR] [--resume] [--shard i/n]\n"
+    "  paddock sweep SWEEP.ini [--jobs N] [--out DIR] [--resume] [--shard i/n] [--plots]\n"
     "      runs a sweep's points (scenarios x [vary] values x seeds) on N cores (default:\n"
     "      all) into DIR (default runs/<sweep name>): DIR/points/NNNN/{scenario.ini,\n"
     "      summary.json}, DIR/results.csv (one row per point), DIR/timing.csv.\n"
@@ -45,6 +46,12 @@ const char* kUsage =
     "      it with sbatch; --wait waits for it and collects\n"
     "  paddock sweep collect DIR\n"
     "      DIR/results.csv and timing.csv from the points' summaries (after Slurm)\n"
+    "  paddock sweep report DIR [--top N]\n"
+    "      the best N configurations (mean over scenarios and seeds) as Markdown, and\n"
+    "      the best one's lines to paste\n"
+    "  paddock sweep plot DIR [PLOT OPTIONS]   (or --plots on a local sweep)\n"
+    "      DIR/plots/: total time against each numeric key, the heat map of the first\n"
+    "      two, the Pareto front of total time against tracking RMS\n"
     "  paddock tune TUNE.ini [--jobs N] [--out DIR] [--max-evals N]\n"
     "      optimises the [optimise] keys within their bounds (NLopt) for the weighted\n"
     "      total cost of the [tune] scenarios' runs; writes DIR/evaluations.csv and\n"
@@ -256,19 +263,48 @@ int cmd_sweep(const std::vector<std::string>& args) {
     if (args.size() != 2) throw UserError(std::string("sweep collect needs one sweep folder\n") + kUsage);
     return collect_sweep(args[1]);
   }
+  if (!args.empty() && args[0] == "report") {
+    std::string dir;
+    int top = 10;
+    for (std::size_t i = 1; i < args.size(); ++i) {
+      if (args[i] == "--top" && i + 1 < args.size()) top = option_int("--top", args[++i], 1, 1000000);
+      else if (!args[i].empty() && args[i][0] == '-') throw UserError("sweep report: unknown option " + args[i] + "\n" + kUsage);
+      else if (dir.empty()) dir = args[i];
+      else throw UserError("sweep report: more than one folder given: " + dir + " and " + args[i]);
+    }
+    if (dir.empty()) throw UserError(std::string("sweep report needs a sweep folder\n") + kUsage);
+    std::cout << sweep_report(sweep_table(dir), top);
+    return 0;
+  }
+  if (!args.empty() && args[0] == "plot") {
+    std::string dir;
+    PlotOptions options;
+    for (std::size_t i = 1; i < args.size(); ++i) {
+      if (plot_option(args, i, options)) continue;
+      if (!args[i].empty() && args[i][0] == '-') throw UserError("sweep plot: unknown option " + args[i] + "\n" + kUsage);
+      if (!dir.empty()) throw UserError("sweep plot: more than one folder given: " + dir + " and " + args[i]);
+      dir = args[i];
+    }
+    if (dir.empty()) throw UserError(std::string("sweep plot needs a sweep folder\n") + kUsage);
+    for (const auto& f : plot_sweep(dir, options)) std::cout << f << "\n";
+    return 0;
+  }
   std::string path;
   SweepOptions o;
   SlurmOptions slurm;
-  bool use_slurm = false, slurm_option = false;
+  PlotOptions plot_options;
+  bool use_slurm = false, slurm_option = false, plots = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&](const char* flag) -> std::string {
       if (i + 1 >= args.size()) throw UserError(std::string(flag) + " needs a value");
       return args[++i];
     };
+    if (plot_option(args, i, plot_options)) continue;
     if (a == "--jobs") o.jobs = option_int("--jobs", value("--jobs"), 1, 4096);
     else if (a == "--out") o.out_dir = value("--out");
     else if (a == "--resume") o.resume = true;
+    else if (a == "--plots") plots = true;
     else if (a == "--shard") std::tie(o.shard, o.shards) = shard_of(value("--shard"));
     else if (a == "--slurm") use_slurm = true;
     else if (a == "--partition" || a == "--time" || a == "--array-limit" || a == "--tasks" || a == "--cpus-per-task" ||
@@ -292,7 +328,13 @@ int cmd_sweep(const std::vector<std::string>& args) {
   if (use_slurm && o.shards > 0) throw UserError("sweep: --slurm and --shard do not go together (each Slurm task runs a shard)");
   if (use_slurm && slurm.dry_run && slurm.wait) throw UserError("sweep: --dry-run and --wait do not go together");
   if (use_slurm) o.slurm = slurm;
-  return run_sweep(path, o);
+  if (plots && (use_slurm || o.shards > 0)) throw UserError("sweep: --plots draws a whole sweep: use paddock sweep plot DIR after collect");
+  const int code = run_sweep(path, o);
+  if (plots && code != 130) {
+    const std::string dir = o.out_dir.empty() ? "runs/" + std::filesystem::path(path).stem().string() : o.out_dir;
+    for (const auto& f : plot_sweep(dir, plot_options)) std::cout << "  figure      " << f << "\n";
+  }
+  return code;
 }
 
 int cmd_tune(const std::vector<std::string>& args) {

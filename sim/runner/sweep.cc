@@ -203,6 +203,32 @@ std::string csv_cell(const std::string& s) {
   return q + "\"";
 }
 
+std::vector<std::string> csv_split(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        out.back() += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        out.back() += c;
+      }
+    } else if (c == '"') {
+      quoted = true;
+    } else if (c == ',') {
+      out.emplace_back();
+    } else {
+      out.back() += c;
+    }
+  }
+  return out;
+}
+
+
 namespace {
 
 // the figures of a point's summary.json for its results.csv row
@@ -497,32 +523,6 @@ Scenario sweep_point_scenario(const SweepSpec& spec, const SweepPoint& point) {
 
 namespace {
 
-// one CSV line's cells (quotes as `cell` writes them)
-std::vector<std::string> csv_cells(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        out.back() += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        out.back() += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      out.emplace_back();
-    } else {
-      out.back() += c;
-    }
-  }
-  return out;
-}
-
 // DIR/points.csv: the points, with the seed each one runs with
 std::string manifest_csv(const SweepSpec& spec, const std::vector<SweepPoint>& points, const std::vector<Scenario>& scenarios) {
   std::ostringstream o;
@@ -558,7 +558,7 @@ Manifest read_manifest(const std::string& dir) {
       continue;
     }
     if (line.empty()) continue;
-    const auto p = whole(csv_cells(line).front());
+    const auto p = whole(csv_split(line).front());
     if (!p || *p != static_cast<std::int64_t>(m.lines.size())) {
       throw UserError(path + ":" + std::to_string(number) + ": expected point " + std::to_string(m.lines.size()));
     }

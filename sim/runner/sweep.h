@@ -141,5 +141,7 @@ std::vector<std::uint64_t> seed_list(const IniEntry& e);
 std::vector<std::string> scenario_list(const IniEntry& e);
 // a CSV cell: quoted when it holds a comma, a quote or a line break
 std::string csv_cell(const std::string& s);
+// one CSV line's cells (quotes as csv_cell writes them)
+std::vector<std::string> csv_split(const std::string& line);
 
 }  // namespace paddock::runner

@@ -5,6 +5,7 @@
 // of the point's own resolved scenario, and --resume running only what is
 // missing.
 #include "sim/runner/sweep.h"
+#include "sim/runner/sweep_report.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -26,6 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 const std::string kRoot = PADDOCK_SOURCE_DIR;
 
@@ -338,6 +340,64 @@ TEST(Sweep, ShardsSplitThePointsAndDryRunOnlyWritesTheScript) {
   EXPECT_EQ(c.code, 1);
   EXPECT_THAT(c.output, HasSubstr("2 points without a summary: 0, 2"));
   EXPECT_THAT(read(dir + "/results.csv"), HasSubstr(",not run\n"));
+}
+
+// ---- the report and the figures, from a results.csv written here
+
+TEST(Sweep, ReportRanksConfigurationsOverEveryRunAndPlotsDraw) {
+  const std::string dir = scratch("report");
+  fs::create_directories(dir);
+  // two keys; configuration (1, a) is fastest on track A but DNFs on B;
+  // (2, a) wins on the mean; (2, b) is close behind with a cone
+  std::string csv = "point,scenario,control.stanley.k,control.lateral,seed,finished,dnf_reason,laps,best_lap_s,mean_lap_s,"
+                    "raw_time_s,total_time_s,doo,oc,uss,penalty_s,tracking_rms_m,tracking_max_m,itae,ate_rms_m,ate_max_m,"
+                    "map_rmse_m,map_precision,map_recall,perception_precision,perception_recall,expectations_failed,error\n";
+  const auto row = [&](int p, const char* sc, const char* k, const char* lat, bool fin, double total, int doo, double rms) {
+    std::ostringstream o;
+    o << p << "," << sc << "," << k << "," << lat << ",1," << (fin ? "true" : "false") << "," << (fin ? "" : "timeout")
+      << ",1,,," << total << "," << total << "," << doo << ",0,0," << 2 * doo << "," << rms << ",,,,,,,,,,0,\n";
+    csv += o.str();
+  };
+  row(0, "A", "1", "a", true, 30.0, 0, 0.1);
+  row(1, "A", "1", "b", true, 31.0, 0, 0.1);
+  row(2, "A", "2", "a", true, 30.5, 0, 0.05);
+  row(3, "A", "2", "b", true, 30.6, 1, 0.07);
+  row(4, "B", "1", "a", false, 0.0, 0, 0.0);
+  row(5, "B", "1", "b", true, 41.0, 0, 0.1);
+  row(6, "B", "2", "a", true, 40.5, 0, 0.05);
+  row(7, "B", "2", "b", true, 40.6, 0, 0.06);
+  write_file_atomic(dir + "/results.csv", csv);
+  const SweepTable t = sweep_table(dir);
+  ASSERT_EQ(t.keys, (std::vector<std::string>{"control.stanley.k", "control.lateral"}));
+  ASSERT_EQ(t.configs.size(), 4u);
+  // by the mean over both tracks: (2, a) 35.5, (2, b) 35.6, (1, b) 36.0, then (1, a) with a DNF
+  EXPECT_EQ(t.configs[0].values, (std::vector<std::string>{"2", "a"}));
+  EXPECT_DOUBLE_EQ(t.configs[0].mean_total, 35.5);
+  EXPECT_DOUBLE_EQ(t.configs[0].worst_total, 40.5);
+  EXPECT_EQ(t.configs[1].values, (std::vector<std::string>{"2", "b"}));
+  EXPECT_EQ(t.configs[1].cones, 1);
+  EXPECT_EQ(t.configs[2].values, (std::vector<std::string>{"1", "b"}));
+  EXPECT_EQ(t.configs[3].values, (std::vector<std::string>{"1", "a"}));
+  EXPECT_EQ(t.configs[3].finished, 1);
+  const std::string md = sweep_report(t, 2);
+  EXPECT_THAT(md, HasSubstr("| 1 | 2 | a | 2 / 2 | 35.500 | 40.500 | 0 | 0.050 | 2 |"));
+  EXPECT_THAT(md, Not(HasSubstr("\n| 3 |")));
+  EXPECT_THAT(md, HasSubstr("[control.stanley]\nk = 2\n\n[control]\nlateral = a\n"));
+  // the figures: one per numeric key, the Pareto front (the heat map needs two numeric keys)
+  const auto o = testing::run_paddock("sweep plot " + dir + " --chart-size 800x600");
+  ASSERT_EQ(o.code, 0) << o.output;
+  for (const char* f : {"/plots/total_time_control_stanley_k.png", "/plots/pareto.png"}) {
+    const std::string png = read(dir + f);
+    ASSERT_GT(png.size(), 1000u) << f;
+    EXPECT_EQ(png.substr(1, 3), "PNG");
+  }
+  EXPECT_FALSE(fs::exists(dir + "/plots/heatmap.png"));
+  EXPECT_FALSE(fs::exists(dir + "/plots/total_time_control_lateral.png"));
+  // a malformed table is a file:line error
+  write_file_atomic(dir + "/results.csv", csv + "9,A,1\n");
+  const auto bad = testing::run_paddock("sweep report " + dir);
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_THAT(bad.output, HasSubstr("results.csv:10: expected 28 cells, got 3"));
 }
 
 }  // namespace
