@@ -52,16 +52,15 @@ std::vector<std::string> split_list(const std::string& s) {
   return out;
 }
 
-namespace {
-
-// a finite number, the whole text
-std::optional<double> number(const std::string& s) {
+std::optional<double> finite_number(const std::string& s) {
   if (s.empty()) return std::nullopt;
   char* end = nullptr;
   const double v = std::strtod(s.c_str(), &end);
   if (*end != '\0' || !std::isfinite(v)) return std::nullopt;
   return v;
 }
+
+namespace {
 
 std::optional<std::int64_t> whole(const std::string& s) {
   if (s.empty()) return std::nullopt;
@@ -96,7 +95,7 @@ std::vector<double> numbers_of(const IniEntry& e, const std::vector<std::string>
   }
   std::vector<double> out;
   for (const std::string& a : args) {
-    const auto v = number(a);
+    const auto v = finite_number(a);
     if (!v) throw UserError(e.where() + ": " + what + ": '" + a + "' is not a finite number");
     out.push_back(*v);
   }

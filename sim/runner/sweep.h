@@ -133,6 +133,8 @@ std::string sweep_point_dir(const std::string& dir, int index, std::size_t count
 std::pair<std::size_t, std::size_t> sweep_shard(std::size_t points, int i, int n);
 
 // shared by sweep and tune files:
+// the whole text as a finite number, or none
+std::optional<double> finite_number(const std::string& s);
 // "a, b, c" -> its trimmed items
 std::vector<std::string> split_list(const std::string& s);
 // `e`'s value as seeds: a list (1, 4, 9) or a range (1..5); throws UserError

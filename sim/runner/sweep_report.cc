@@ -20,14 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::optional<double> number_cell(const std::string& s) {
-  if (s.empty()) return std::nullopt;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (*end != '\0' || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
-
 // results.csv's rows by column name
 struct Results {
   std::vector<std::string> keys;
@@ -98,13 +90,13 @@ SweepTable sweep_table(const std::string& dir) {
     double sum = 0.0, rms = 0.0;
     for (std::size_t i : rows) {
       ++c.runs;
-      c.cones += static_cast<int>(number_cell(r.at(i, "doo")).value_or(0.0));
+      c.cones += static_cast<int>(finite_number(r.at(i, "doo")).value_or(0.0));
       if (!finished(r, i)) continue;
       ++c.finished;
-      const double total = number_cell(r.at(i, "total_time_s")).value_or(NAN);
+      const double total = finite_number(r.at(i, "total_time_s")).value_or(NAN);
       sum += total;
       c.worst_total = std::max(c.worst_total, total);
-      rms += number_cell(r.at(i, "tracking_rms_m")).value_or(NAN);
+      rms += finite_number(r.at(i, "tracking_rms_m")).value_or(NAN);
     }
     c.mean_total = c.finished > 0 ? sum / c.finished : NAN;
     c.mean_rms = c.finished > 0 ? rms / c.finished : NAN;
@@ -174,7 +166,7 @@ std::vector<std::string> plot_sweep(const std::string& dir, const PlotOptions& o
   std::vector<std::size_t> numeric;
   for (std::size_t k = 0; k < r.keys.size(); ++k) {
     bool all = !r.rows.empty();
-    for (const auto& row : r.rows) all = all && number_cell(row[2 + k]).has_value();
+    for (const auto& row : r.rows) all = all && finite_number(row[2 + k]).has_value();
     if (all) numeric.push_back(k);
   }
 
@@ -187,7 +179,7 @@ std::vector<std::string> plot_sweep(const std::string& dir, const PlotOptions& o
   for (std::size_t i = 0; i < r.rows.size(); ++i) {
     if (!finished(r, i)) continue;
     const std::string& sc = r.rows[i][1];
-    const double total = number_cell(r.at(i, "total_time_s")).value_or(INFINITY);
+    const double total = finite_number(r.at(i, "total_time_s")).value_or(INFINITY);
     if (!best_of.count(sc)) scenario_order.push_back(sc);
     best_of[sc] = std::min(best_of.count(sc) ? best_of[sc] : INFINITY, total);
   }
@@ -208,9 +200,9 @@ std::vector<std::string> plot_sweep(const std::string& dir, const PlotOptions& o
     for (std::size_t i = 0; i < r.rows.size(); ++i) {
       if (!finished(r, i)) continue;
       const std::string& sc = r.rows[i][1];
-      const double x = *number_cell(r.rows[i][2 + k]);
-      const double y = 100.0 * (number_cell(r.at(i, "total_time_s")).value_or(nan) / best_of[sc] - 1.0);
-      const bool pen = number_cell(r.column.count("penalty_s") ? r.at(i, "penalty_s") : "").value_or(0.0) > 0.0;
+      const double x = *finite_number(r.rows[i][2 + k]);
+      const double y = 100.0 * (finite_number(r.at(i, "total_time_s")).value_or(nan) / best_of[sc] - 1.0);
+      const bool pen = finite_number(r.column.count("penalty_s") ? r.at(i, "penalty_s") : "").value_or(0.0) > 0.0;
       const auto j = static_cast<std::size_t>(std::find(scenario_order.begin(), scenario_order.end(), sc) - scenario_order.begin());
       render::LineSeries& s = pen ? penalised : per_scenario[j];
       s.x.insert(s.x.end(), {x, nan});
@@ -233,8 +225,8 @@ std::vector<std::string> plot_sweep(const std::string& dir, const PlotOptions& o
     const std::size_t a = numeric[0], b = numeric[1];
     std::vector<double> xs, ys;
     for (const auto& row : r.rows) {
-      xs.push_back(*number_cell(row[2 + a]));
-      ys.push_back(*number_cell(row[2 + b]));
+      xs.push_back(*finite_number(row[2 + a]));
+      ys.push_back(*finite_number(row[2 + b]));
     }
     std::sort(xs.begin(), xs.end());
     xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
@@ -244,14 +236,14 @@ std::vector<std::string> plot_sweep(const std::string& dir, const PlotOptions& o
       std::vector<double> sum(xs.size() * ys.size(), 0.0), count(xs.size() * ys.size(), 0.0);
       std::vector<bool> dnf(xs.size() * ys.size(), false);
       for (std::size_t i = 0; i < r.rows.size(); ++i) {
-        const auto ix = static_cast<std::size_t>(std::lower_bound(xs.begin(), xs.end(), *number_cell(r.rows[i][2 + a])) - xs.begin());
-        const auto iy = static_cast<std::size_t>(std::lower_bound(ys.begin(), ys.end(), *number_cell(r.rows[i][2 + b])) - ys.begin());
+        const auto ix = static_cast<std::size_t>(std::lower_bound(xs.begin(), xs.end(), *finite_number(r.rows[i][2 + a])) - xs.begin());
+        const auto iy = static_cast<std::size_t>(std::lower_bound(ys.begin(), ys.end(), *finite_number(r.rows[i][2 + b])) - ys.begin());
         const std::size_t cell = iy * xs.size() + ix;
         if (!finished(r, i)) {
           dnf[cell] = true;
           continue;
         }
-        sum[cell] += number_cell(r.at(i, "total_time_s")).value_or(nan);
+        sum[cell] += finite_number(r.at(i, "total_time_s")).value_or(nan);
         count[cell] += 1.0;
       }
       render::HeatmapData h;

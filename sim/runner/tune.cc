@@ -28,14 +28,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::optional<double> finite_number(const std::string& s) {
-  if (s.empty()) return std::nullopt;
-  char* end = nullptr;
-  const double v = std::strtod(s.c_str(), &end);
-  if (*end != '\0' || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
-
 double number_of(const IniEntry& e, double lo, double hi, const std::string& what) {
   const auto v = finite_number(e.value);
   if (!v || *v < lo || *v > hi) {
@@ -167,8 +159,10 @@ class Tuner {
     const std::string ini = resolved_ini(scenario(0, nullptr));
     std::vector<double> x;
     for (const TuneKey& k : spec_.keys) {
-      const auto v = finite_number(resolved_value(ini, k));
-      if (!v) throw UserError(k.where.where() + ": [optimise] " + k.name() + " is no number in the scenario (it has '" + resolved_value(ini, k) + "')");
+      const std::string text = resolved_value(ini, k);
+      if (text.empty()) throw UserError(k.where.where() + ": [optimise] " + k.name() + " is not a scenario key (paddock keys lists them)");
+      const auto v = finite_number(text);
+      if (!v) throw UserError(k.where.where() + ": [optimise] " + k.name() + " is no number in the scenario (it has '" + text + "')");
       x.push_back(std::min(k.hi, std::max(k.lo, *v)));
     }
     return x;
@@ -181,10 +175,20 @@ class Tuner {
     }
     Evaluation ev;
     ev.values = values;
-    std::vector<Scenario> scenarios;
-    for (std::size_t r = 0; r < runs_.size(); ++r) scenarios.push_back(scenario(r, &values));
     ev.costs.assign(runs_.size(), 0.0);
     ev.notes.assign(runs_.size(), "");
+    // a point the scenario refuses (a constraint between keys the bounds
+    // cannot say, such as k_max >= k_min) costs as a DNF
+    std::vector<std::optional<Scenario>> scenarios(runs_.size());
+    for (std::size_t r = 0; r < runs_.size(); ++r) {
+      try {
+        scenarios[r] = scenario(r, &values);
+      } catch (const UserError& e) {
+        ev.costs[r] = spec_.dnf_cost;
+        const std::string what = e.what();
+        ev.notes[r] = "refused: " + what.substr(what.find(": ") == std::string::npos ? 0 : what.find(": ") + 2);
+      }
+    }
     // the runs at once, `jobs` threads
     const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
     const std::size_t jobs = std::min<std::size_t>(options_.jobs > 0 ? static_cast<std::size_t>(options_.jobs) : cores, runs_.size());
@@ -193,8 +197,9 @@ class Tuner {
     for (std::size_t j = 0; j < jobs; ++j) {
       pool.emplace_back([&, j] {
         for (std::size_t r = j; r < runs_.size(); r += jobs) {
+          if (!scenarios[r]) continue;
           try {
-            const RunResult res = run(scenarios[r], track(scenarios[r].track_path));
+            const RunResult res = run(*scenarios[r], track(scenarios[r]->track_path));
             ev.costs[r] = cost(res);
             ev.notes[r] = res.event.finished ? fixed(res.event.total_time, 3) + " s, " + std::to_string(res.event.doo) + " DOO"
                                              : "DNF (" + res.event.dnf_reason + ")";
@@ -381,25 +386,12 @@ TuneResult run_tune(const std::string& path, const TuneOptions& options) {
   const std::string dir = options.out_dir.empty() ? (fs::path("runs") / spec.name).string() : options.out_dir;
   Tuner tuner(spec, options);
   TuneResult result;
-  // the keys exist and take numbers (checked at their low ends), then the start
-  for (std::size_t r = 0; r < tuner.runs(); ++r) {
-    std::vector<double> x;
-    for (const TuneKey& k : spec.keys) x.push_back(k.lo);
-    tuner.scenario(r, &x);
-  }
+  // the keys exist and take numbers: every scenario builds with the start
+  // (a bad key is a file:line error now, not after the first runs); a point
+  // refused later (a constraint between keys) costs as a DNF
+  for (std::size_t r = 0; r < tuner.runs(); ++r) tuner.scenario(r, nullptr);
   result.start = tuner.start();
-  // every scenario builds with the start and with both ends of every key
-  // before the first run (a bad key is a file:line error now, not later)
-  for (std::size_t r = 0; r < tuner.runs(); ++r) {
-    tuner.scenario(r, &result.start);
-    for (std::size_t i = 0; i < spec.keys.size(); ++i) {
-      std::vector<double> x = result.start;
-      x[i] = spec.keys[i].lo;
-      tuner.scenario(r, &x);
-      x[i] = spec.keys[i].hi;
-      tuner.scenario(r, &x);
-    }
-  }
+  for (std::size_t r = 0; r < tuner.runs(); ++r) tuner.scenario(r, &result.start);
   const int max_evals = options.max_evals > 0 ? options.max_evals : spec.max_evals;
   std::cerr << "tune " << spec.name << ": " << spec.keys.size() << " keys, " << tuner.runs() << " runs an evaluation, "
             << spec.algorithm << ", at most " << max_evals << " evaluations, into " << dir << "/\n";

@@ -113,8 +113,8 @@ TEST(Tune, BadFilesAreFileLineErrors) {
   EXPECT_THAT(tune_error(head + "weights = 1, 2\n[optimise]\ncontrol.stanley.k = bounds(1, 3)\n"), HasSubstr("bad.ini:3: [tune] weights: expected one per scenario (1), got 2"));
   EXPECT_THAT(tune_error(head), HasSubstr("no [optimise] keys"));
   // a key the scenario does not know, or that is no number, on its own line
-  EXPECT_THAT(tune_error(head + "[optimise]\ncontrol.stanly.k = bounds(1, 3)\n"), HasSubstr("bad.ini:4: unknown section [control.stanly]"));
-  EXPECT_THAT(tune_error(head + "[optimise]\ncontrol.lateral = bounds(1, 3)\n"), HasSubstr("bad.ini:4: [control] lateral = '1' is not known"));
+  EXPECT_THAT(tune_error(head + "[optimise]\ncontrol.stanly.k = bounds(1, 3)\n"), HasSubstr("bad.ini:4: [optimise] control.stanly.k is not a scenario key"));
+  EXPECT_THAT(tune_error(head + "[optimise]\ncontrol.lateral = bounds(1, 3)\n"), HasSubstr("bad.ini:4: [optimise] control.lateral is no number in the scenario (it has 'combined')"));
 }
 
 }  // namespace
