@@ -179,6 +179,15 @@ launch() {
 # DIR/run/NAME.pid is alive and ours?
 alive() { ours "$(cat "$1/run/$2.pid" 2>/dev/null || true)" "$1"; }
 
+# the process `launch` just started is still there? (during start: until
+# `env` has exec'd the daemon, its environment does not show the marker yet,
+# so `alive` would call a daemon that is starting dead)
+running() {
+  local pid
+  pid="$(cat "$1/run/$2.pid" 2>/dev/null || true)"
+  [ -n "$pid" ] && kill -0 "$pid" 2>/dev/null && [ "$(cut -d' ' -f3 "/proc/$pid/stat" 2>/dev/null)" != Z ]
+}
+
 # one attempt: configure, launch the three daemons, wait for the node to be
 # idle. Returns 0 when up, 2 when a port was taken meanwhile, 1 otherwise.
 start_once() {
@@ -205,7 +214,7 @@ start_once() {
     --seed-file="$dir/state/munged.seed"
   for ((i = 0; i < 100; i++)); do
     [ -S "$dir/run/munge.socket" ] && break
-    alive "$dir" munged || { say "munged exited at start"; return 1; }
+    running "$dir" munged || { say "munged exited at start"; return 1; }
     sleep 0.1
   done
   [ -S "$dir/run/munge.socket" ] || { say "munged made no socket in 10 s"; return 1; }
@@ -217,7 +226,7 @@ start_once() {
   # wait for the node to be idle, watching that every daemon is still alive
   for ((i = 0; i < timeout_s * 4; i++)); do
     for d in munged slurmctld slurmd; do
-      if ! alive "$dir" "$d"; then
+      if ! running "$dir" "$d"; then
         say "$d exited during start"
         if grep -qs "Address already in use" "$dir/log/$d.out" "$dir/log/$d.log"; then
           return 2
