@@ -263,13 +263,21 @@ struct PrivateSlurm {
       return;
     }
     dir = tmpl;
-    const auto o = testing::run_paddock_command(tool + " start " + dir + " 2>" + dir + "/start.log");
+    // (a second try after a failed start: a loaded machine's timing, not a
+    // persistent fault; both tries' logs are kept in the message)
     const std::string key = "export SLURM_CONF=";
-    const auto at = o.output.find(key);
-    if (o.code != 0 || at == std::string::npos) {
-      error = "the private Slurm did not start: " + o.output + read_file(dir + "/start.log");
-      return;
+    testing::Outcome o;
+    std::string::size_type at = std::string::npos;
+    for (int attempt = 0; attempt < 2 && at == std::string::npos; ++attempt) {
+      o = testing::run_paddock_command(tool + " start " + dir + " 2>" + dir + "/start.log");
+      at = o.code == 0 ? o.output.find(key) : std::string::npos;
+      if (at == std::string::npos) {
+        error += "the private Slurm did not start: " + o.output + read_file(dir + "/start.log");
+        (void)std::system((tool + " stop " + dir + " >/dev/null 2>&1").c_str());
+      }
     }
+    if (at == std::string::npos) return;
+    error.clear();
     const std::string conf = o.output.substr(at + key.size(), o.output.find('\n', at) - at - key.size());
     setenv("SLURM_CONF", conf.c_str(), 1);
   }
