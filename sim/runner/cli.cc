@@ -229,16 +229,24 @@ int cmd_report(const std::vector<std::string>& args) {
   throw UserError(std::string("report needs 'controllers SCENARIO', 'smoothing TRACK' or 'vehicle [CAR]'\n") + kUsage);
 }
 
-int cmd_plot(const std::vector<std::string>& args) {
+// a command's folder and plot options (args from `first` on); `what` names
+// the command and the folder in messages
+std::string folder_and_plot_options(const std::vector<std::string>& args, std::size_t first, const std::string& what,
+                                    PlotOptions& options) {
   std::string dir;
-  PlotOptions options;
-  for (std::size_t i = 0; i < args.size(); ++i) {
+  for (std::size_t i = first; i < args.size(); ++i) {
     if (plot_option(args, i, options)) continue;
     if (!args[i].empty() && args[i][0] == '-') throw UserError("unknown option " + args[i] + "\n" + kUsage);
-    if (!dir.empty()) throw UserError("more than one run folder given: " + dir + " and " + args[i]);
+    if (!dir.empty()) throw UserError(what + ": more than one folder given: " + dir + " and " + args[i]);
     dir = args[i];
   }
-  if (dir.empty()) throw UserError(std::string("plot needs a run folder\n") + kUsage);
+  if (dir.empty()) throw UserError(what + " needs a folder\n" + kUsage);
+  return dir;
+}
+
+int cmd_plot(const std::vector<std::string>& args) {
+  PlotOptions options;
+  const std::string dir = folder_and_plot_options(args, 0, "plot", options);
   for (const auto& f : plot_run(dir, options)) std::cout << f << "\n";
   return 0;
 }
@@ -277,15 +285,8 @@ int cmd_sweep(const std::vector<std::string>& args) {
     return 0;
   }
   if (!args.empty() && args[0] == "plot") {
-    std::string dir;
     PlotOptions options;
-    for (std::size_t i = 1; i < args.size(); ++i) {
-      if (plot_option(args, i, options)) continue;
-      if (!args[i].empty() && args[i][0] == '-') throw UserError("sweep plot: unknown option " + args[i] + "\n" + kUsage);
-      if (!dir.empty()) throw UserError("sweep plot: more than one folder given: " + dir + " and " + args[i]);
-      dir = args[i];
-    }
-    if (dir.empty()) throw UserError(std::string("sweep plot needs a sweep folder\n") + kUsage);
+    const std::string dir = folder_and_plot_options(args, 1, "sweep plot", options);
     for (const auto& f : plot_sweep(dir, options)) std::cout << f << "\n";
     return 0;
   }

@@ -8,9 +8,6 @@
 #include "sim/runner/files.h"
 
 namespace paddock::runner {
-namespace {
-
-namespace fs = std::filesystem;
 
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t\r");
@@ -18,6 +15,10 @@ std::string trim(const std::string& s) {
   const auto e = s.find_last_not_of(" \t\r");
   return s.substr(b, e - b + 1);
 }
+
+namespace {
+
+namespace fs = std::filesystem;
 
 // a ';' or '#' that starts the line or follows whitespace begins a comment
 std::string strip_comment(const std::string& s) {

@@ -29,6 +29,9 @@ struct IniEntry {
 // with "file:line: what is wrong" for syntax errors, missing files and cycles
 std::vector<IniEntry> read_ini_file(const std::string& path);
 
+// `s` without its leading and trailing blanks (spaces, tabs, carriage returns)
+std::string trim(const std::string& s);
+
 // the same for text already in memory; includes are read relative to base_dir
 std::vector<IniEntry> parse_ini_text(const std::string& text, const std::string& source,
                                      const std::string& base_dir);

@@ -17,12 +17,6 @@
 namespace paddock::runner {
 namespace {
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
-
 // keys renamed when the sections began to follow the struct paths
 // (2026-11): an old key's error names its new place
 constexpr std::pair<const char*, const char*> kRenamed[] = {

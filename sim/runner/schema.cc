@@ -14,12 +14,6 @@
 namespace paddock::runner {
 namespace {
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string::npos) return "";
-  return s.substr(b, s.find_last_not_of(" \t") - b + 1);
-}
-
 // other units accepted for a stored SI unit, with their factor to it
 const std::map<std::string, std::map<std::string, double>>& conversions() {
   static const std::map<std::string, std::map<std::string, double>> table = {
