@@ -15,17 +15,29 @@ bool all_finite(const std::vector<double>& v) {
   return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
 }
 
-// the share of the lateral limit a speed uses on a curvature, in [0, inf)
-double lateral_use(double v, double kappa, const VelocityProfileParams& p) {
-  return v * v * std::abs(kappa) / p.ay_max;
+// linear interpolation in a table, the end values held beyond its ends
+double interpolate(const std::vector<double>& xs, const std::vector<double>& ys, double x) {
+  if (x <= xs.front()) return ys.front();
+  if (x >= xs.back()) return ys.back();
+  const std::size_t j = static_cast<std::size_t>(std::upper_bound(xs.begin(), xs.end(), x) - xs.begin());
+  const double t = (x - xs[j - 1]) / (xs[j] - xs[j - 1]);
+  return ys[j - 1] + t * (ys[j] - ys[j - 1]);
+}
+
+bool ggv(const VelocityProfileParams& p) { return p.limits == VelocityProfileParams::Ggv; }
+
+// the lateral limit at speed v (m/s^2)
+double lateral_limit(double v, const VelocityProfileParams& p) {
+  return ggv(p) ? p.margin_lateral * interpolate(p.ggv_speed, p.ggv_lateral, v) : p.ay_max;
 }
 
 // the longitudinal tyre limit left over by the lateral acceleration: the g-g
-// shape (ax/ax_lim)^p + (ay/ay_max)^p = 1 solved for ax, zero once the turn
+// shape (ax/ax_lim)^p + (ay/ay_lim)^p = 1 solved for ax, zero once the turn
 // alone uses all the grip; with turn_accel_scale < 1 the limit shrinks with
 // the lateral use (see the parameter's comment)
 double tyre_longitudinal(double ax_lim, double v, double kappa, const VelocityProfileParams& p) {
-  const double use = lateral_use(v, kappa, p);
+  // the share of the lateral limit a speed uses on a curvature, in [0, inf)
+  const double use = v * v * std::abs(kappa) / lateral_limit(v, p);
   const double f = 1.0 - (1.0 - p.turn_accel_scale) * std::min(1.0, use);
   // the ellipse (p = 2) and the diamond (p = 1) without pow(), the common cases
   const bool ellipse = p.exponent == 2.0, diamond = p.exponent == 1.0;
@@ -35,8 +47,36 @@ double tyre_longitudinal(double ax_lim, double v, double kappa, const VelocityPr
   return f * ax_lim * root;
 }
 
+// the g-g-v envelope's net values already carry the drag
 double drag_decel(double v, const VelocityProfileParams& p) {
-  return p.drag_coefficient * v * v / p.mass;
+  return ggv(p) ? 0.0 : p.drag_coefficient * v * v / p.mass;
+}
+
+// the fastest speed at which a curvature uses no more than the lateral
+// limit, v^2 |kappa| <= ay(v): the first crossing from rest, since a limit
+// that grows with speed (downforce) could allow a second, faster band the car
+// cannot reach through the slower speeds. Infinite on a straight, or when the
+// limit outgrows v^2 |kappa| for good.
+double corner_speed(double kappa, const VelocityProfileParams& p) {
+  const double k = std::abs(kappa);
+  if (!(k > 0.0)) return kInf;
+  if (!ggv(p)) return std::sqrt(p.ay_max / k);
+  const std::vector<double>& s = p.ggv_speed;
+  const double m = p.margin_lateral;
+  // below the first node the limit is constant
+  const double v0 = std::sqrt(m * p.ggv_lateral.front() / k);
+  if (v0 <= s.front()) return v0;
+  // on a segment the limit is a0 + a1 v: the root of k v^2 - a1 v - a0 = 0
+  for (std::size_t j = 0; j + 1 < s.size(); ++j) {
+    const double l0 = m * p.ggv_lateral[j], l1 = m * p.ggv_lateral[j + 1];
+    if (s[j + 1] * s[j + 1] * k <= l1) continue;  // still within the limit at the segment's end
+    const double a1 = (l1 - l0) / (s[j + 1] - s[j]);
+    const double a0 = l0 - a1 * s[j];
+    const double v = (a1 + std::sqrt(a1 * a1 + 4.0 * k * a0)) / (2.0 * k);
+    return std::clamp(v, s[j], s[j + 1]);
+  }
+  // above the last node the limit is constant again
+  return std::max(s.back(), std::sqrt(m * p.ggv_lateral.back() / k));
 }
 
 // speed after one segment of length ds at constant acceleration a, from
@@ -78,18 +118,32 @@ bool backward_step(std::vector<double>& v, const std::vector<double>& kappa, std
 }  // namespace
 
 double available_acceleration(double v, double kappa, const VelocityProfileParams& p) {
+  if (ggv(p)) return tyre_longitudinal(p.margin_longitudinal * interpolate(p.ggv_speed, p.ggv_accel, v), v, kappa, p);
   const double tyre = tyre_longitudinal(p.ax_max, v, kappa, p);
   return std::min(tyre, p.ax_machine) - drag_decel(v, p);
 }
 
 double available_deceleration(double v, double kappa, const VelocityProfileParams& p) {
+  if (ggv(p)) return tyre_longitudinal(p.margin_longitudinal * interpolate(p.ggv_speed, p.ggv_brake, v), v, kappa, p);
   return tyre_longitudinal(p.ax_brake_max, v, kappa, p) + drag_decel(v, p);
 }
+
+double planned_lateral_limit(double v, const VelocityProfileParams& p) { return lateral_limit(v, p); }
 
 std::string VelocityProfileParams::check() const {
   if (!(std::isfinite(mass) && mass > 0.0)) return "mass must be > 0 kg (got " + params::number(mass) + ")";
   if (!(std::isfinite(drag_coefficient) && drag_coefficient >= 0.0))
     return "drag_coefficient must be >= 0 N s^2/m^2 (got " + params::number(drag_coefficient) + ")";
+  const std::size_t n = ggv_speed.size();
+  if (n == 0) return "ggv_speed needs at least one speed";
+  if (ggv_lateral.size() != n || ggv_accel.size() != n || ggv_brake.size() != n)
+    return "ggv_lateral, ggv_accel and ggv_brake need one value per ggv_speed (" + std::to_string(n) +
+           "), got " + std::to_string(ggv_lateral.size()) + ", " + std::to_string(ggv_accel.size()) + " and " +
+           std::to_string(ggv_brake.size());
+  for (std::size_t i = 1; i < n; ++i)
+    if (!(ggv_speed[i] > ggv_speed[i - 1]))
+      return "ggv_speed must be strictly ascending (" + params::number(ggv_speed[i - 1]) + " then " +
+             params::number(ggv_speed[i]) + ")";
   return "";
 }
 
@@ -136,11 +190,7 @@ VelocityProfile solve_velocity_profile(const std::vector<double>& curvature,
   // the corner speeds: all the lateral grip used, v^2 |kappa| = ay_max;
   // a straight's infinite corner speed never leaves the min with v_max
   std::vector<double> v(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double k = std::abs(curvature[i]);
-    const double v_corner = k > 0.0 ? std::sqrt(params.ay_max / k) : kInf;
-    v[i] = std::min(v_corner, params.v_max);
-  }
+  for (std::size_t i = 0; i < n; ++i) v[i] = std::min(corner_speed(curvature[i], params), params.v_max);
 
   if (!closed) {
     // open: the start bound, a forward (acceleration) pass, the end bound,

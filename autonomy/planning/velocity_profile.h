@@ -58,6 +58,32 @@ struct VelocityProfileParams {
   // cones).
   double turn_accel_scale = 0.4;
 
+  // where the limits come from: `constant` = ax_max, ay_max, ax_brake_max,
+  // ax_machine and the drag term above (the paper's and the reference's
+  // model, ORACLES A-D3); `ggv` = the car's g-g-v envelope below, scaled by
+  // the two margins, in their place.
+  enum Limits { Constant, Ggv };
+  static constexpr params::Choice<Limits> kLimitsNames[] = {{"constant", Constant}, {"ggv", Ggv}};
+  Limits limits = Constant;
+  // the car's g-g-v envelope (limits = ggv), what a team measures of its own
+  // car on track: at speed ggv_speed[i] it corners at up to ggv_lateral[i]
+  // and accelerates at ggv_accel[i] and brakes at ggv_brake[i] on a level
+  // straight, net (drag, rolling resistance and the motors' power limit
+  // included, so no drag term is added); linear in between, the end values
+  // held beyond the ends. `paddock report vehicle` measures it on the
+  // simulated car and prints these four lines. Each combines with the
+  // others through the g-g shape (exponent) and turn_accel_scale as the
+  // constant limits do. The defaults are the default car's
+  // (scenarios/vehicles/default.ini), rounded down.
+  std::vector<double> ggv_speed = {0.0, 10.0, 15.0, 20.0, 25.0, 30.0, 34.0};
+  std::vector<double> ggv_lateral = {16.0, 16.5, 17.0, 17.5, 18.0, 18.5, 18.5};
+  std::vector<double> ggv_accel = {14.5, 14.5, 14.2, 11.1, 8.7, 6.4, 0.0};
+  std::vector<double> ggv_brake = {14.4, 14.7, 15.3, 16.2, 17.5, 19.0, 19.0};
+  // the shares of the envelope planned with (limits = ggv): the rest is the
+  // reserve for tracking, localisation and perception errors
+  double margin_lateral = 0.8;
+  double margin_longitudinal = 0.8;
+
   template <class V>
   void visit(V& v) {
     v(PADDOCK_PARAM(ax_max), {"m/s^2", params::in(0.1, 100.0), "tyre acceleration limit of the profile"});
@@ -67,6 +93,13 @@ struct VelocityProfileParams {
     v(PADDOCK_PARAM(ax_machine), {"m/s^2", params::in(0.1, 100.0), "motor acceleration limit"});
     v(PADDOCK_PARAM(v_max), {"m/s", params::in(0.1, 100.0), "top speed of the profile"});
     v(PADDOCK_PARAM(turn_accel_scale), {"", params::fraction(), "longitudinal limits kept in a full-grip turn"});
+    v(PADDOCK_PARAM(limits), kLimitsNames, "constant: the limits above; ggv: the car's g-g-v envelope below");
+    v(PADDOCK_PARAM(ggv_speed), {"m/s", params::at_least(0.0), "g-g-v envelope: speeds, ascending"});
+    v(PADDOCK_PARAM(ggv_lateral), {"m/s^2", params::above(0.0), "g-g-v envelope: lateral limit at each speed"});
+    v(PADDOCK_PARAM(ggv_accel), {"m/s^2", params::at_least(0.0), "g-g-v envelope: net straight-line acceleration"});
+    v(PADDOCK_PARAM(ggv_brake), {"m/s^2", params::above(0.0), "g-g-v envelope: net straight-line braking"});
+    v(PADDOCK_PARAM(margin_lateral), {"", params::above_up_to(0.0, 1.0), "share of the envelope's lateral limit planned with"});
+    v(PADDOCK_PARAM(margin_longitudinal), {"", params::above_up_to(0.0, 1.0), "share of the envelope's acceleration and braking planned with"});
   }
   std::string check() const;
 };
@@ -130,5 +163,8 @@ double profile_time(const std::vector<double>& speed, const std::vector<double>&
 // Exposed for tests that check the profile against the limits.
 double available_acceleration(double v, double kappa, const VelocityProfileParams& p);
 double available_deceleration(double v, double kappa, const VelocityProfileParams& p);
+// the lateral acceleration the profile allows at speed v (m/s^2): ay_max, or
+// the envelope's times margin_lateral
+double planned_lateral_limit(double v, const VelocityProfileParams& p);
 
 }  // namespace paddock::planning

@@ -367,5 +367,118 @@ TEST(VelocityProfile, DefaultsAreValid) {
   EXPECT_LE(q.ax_machine, 5000.0 / 190.0);
 }
 
+
+// ---- the g-g-v envelope (limits = ggv) --------------------------------------
+
+// an envelope with the given lines at speeds 0 and 40 m/s (linear between)
+VelocityProfileParams ggv_params(double lat0, double lat40, double acc0, double acc40, double brk0, double brk40) {
+  VelocityProfileParams q;
+  q.limits = VelocityProfileParams::Ggv;
+  q.ggv_speed = {0.0, 40.0};
+  q.ggv_lateral = {lat0, lat40};
+  q.ggv_accel = {acc0, acc40};
+  q.ggv_brake = {brk0, brk40};
+  q.margin_lateral = 1.0;
+  q.margin_longitudinal = 1.0;
+  q.turn_accel_scale = 1.0;
+  q.v_max = 100.0;
+  return q;
+}
+
+TEST(VelocityProfileGgv, ConstantEnvelopeReproducesOraclesAAndB) {
+  // a flat envelope is the constant model without drag: ORACLES A (lateral
+  // only) and B (the machine's 5.3 m/s^2 on a straight, braking at 12)
+  VelocityProfileParams q = ggv_params(12.0, 12.0, 5.3, 5.3, 12.0, 12.0);
+  q.exponent = 1.0;
+  const std::size_t n = 126;
+  const auto circle = solve_velocity_profile(std::vector<double>(n, 0.1),
+                                             std::vector<double>(n, 2.0 * kPi * 10.0 / static_cast<double>(n)), true, q);
+  ASSERT_TRUE(circle.ok()) << circle.reason;
+  for (double v : circle.speed) EXPECT_NEAR(v, 10.954451, 1e-3);
+  const Path path = straight(100.0, 1.0);
+  const auto prof = solve_velocity_profile(path.kappa, path.ds, false, q, 0.0, 0.0);
+  ASSERT_TRUE(prof.ok()) << prof.reason;
+  EXPECT_NEAR(vmax(prof.speed), 27.0444, 1e-3);
+  EXPECT_NEAR(prof.speed[1], 3.2558, 1e-3);
+  EXPECT_NEAR(profile_time(prof.speed, path.ds, false), 7.3759, 1e-3);
+}
+
+TEST(VelocityProfileGgv, CircleWithDownforceSolvesTheQuadratic) {
+  // ay(v) = 10 + 0.2 v (downforce): on R = 20 m, v^2 / 20 = 10 + 0.2 v,
+  // v = 2 + sqrt(204) = 16.2829 m/s, a speed between the nodes
+  const VelocityProfileParams q = ggv_params(10.0, 18.0, 5.0, 5.0, 10.0, 10.0);
+  const std::size_t n = 200;
+  const auto prof = solve_velocity_profile(std::vector<double>(n, -0.05),
+                                           std::vector<double>(n, 2.0 * kPi * 20.0 / static_cast<double>(n)), true, q);
+  ASSERT_TRUE(prof.ok()) << prof.reason;
+  const double expected = 2.0 + std::sqrt(204.0);
+  for (double v : prof.speed) EXPECT_NEAR(v, expected, 1e-9);
+  EXPECT_NEAR(planned_lateral_limit(expected, q), expected * expected / 20.0, 1e-9);
+}
+
+TEST(VelocityProfileGgv, CornerSpeedBeyondTheTableAndTheMargin) {
+  // the last node's limit is held beyond it; the margin scales it: R = 100 m
+  // at 0.5 x 18 m/s^2 gives sqrt(900) = 30 m/s, under the 40 m/s node...
+  VelocityProfileParams q = ggv_params(10.0, 18.0, 5.0, 5.0, 10.0, 10.0);
+  q.ggv_speed = {0.0, 20.0};
+  q.margin_lateral = 0.5;
+  const std::size_t n = 400;
+  const std::vector<double> ds(n, 2.0 * kPi * 100.0 / static_cast<double>(n));
+  auto prof = solve_velocity_profile(std::vector<double>(n, 0.01), ds, true, q);
+  ASSERT_TRUE(prof.ok()) << prof.reason;
+  for (double v : prof.speed) EXPECT_NEAR(v, 30.0, 1e-9);
+  // ...and with the full envelope: sqrt(18 * 100) = 42.43 m/s, above the last node
+  q.margin_lateral = 1.0;
+  prof = solve_velocity_profile(std::vector<double>(n, 0.01), ds, true, q);
+  ASSERT_TRUE(prof.ok()) << prof.reason;
+  for (double v : prof.speed) EXPECT_NEAR(v, std::sqrt(1800.0), 1e-9);
+}
+
+// the distance to reach speed v from rest at a(u) = a0 - k u (closed form of
+// ds = u du / a(u))
+double distance_to_speed(double v, double a0, double k) {
+  return -v / k - a0 / (k * k) * std::log(1.0 - k * v / a0);
+}
+
+TEST(VelocityProfileGgv, StraightFromRestMatchesTheClosedForm) {
+  // full throttle with a(v) = 12 - 0.3 v (drag and power in the measured
+  // line), reaching 40 m/s asymptotically; the speed at 20, 50 and 100 m
+  // against the closed form, solved by bisection
+  const VelocityProfileParams q = ggv_params(15.0, 15.0, 12.0, 0.0, 10.0, 10.0);
+  const double ds = 0.02;
+  const Path path = straight(100.0, ds);
+  const auto prof = solve_velocity_profile(path.kappa, path.ds, false, q, 0.0, std::nullopt);
+  ASSERT_TRUE(prof.ok()) << prof.reason;
+  for (double s : {20.0, 50.0, 100.0}) {
+    double lo = 0.0, hi = 39.999999;
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (distance_to_speed(mid, 12.0, 0.3) < s ? lo : hi) = mid;
+    }
+    const auto i = static_cast<std::size_t>(std::lround(s / ds));
+    EXPECT_NEAR(prof.speed[i], lo, 2e-3 * lo) << "at " << s << " m";
+  }
+  // and the braking end: from 30 m/s to rest at a constant 10 m/s^2 takes 45 m
+  const auto stop = solve_velocity_profile(path.kappa, path.ds, false, q, 30.0, 0.0);
+  ASSERT_TRUE(stop.ok()) << stop.reason;
+  const auto j = static_cast<std::size_t>(std::lround((100.0 - 20.0) / ds));
+  EXPECT_NEAR(stop.speed[j], std::sqrt(2.0 * 10.0 * 20.0), 1e-6);
+}
+
+TEST(VelocityProfileGgv, BadEnvelopesGiveAReason) {
+  VelocityProfileParams q = ggv_params(10.0, 18.0, 5.0, 5.0, 10.0, 10.0);
+  const std::vector<double> kappa(10, 0.0), ds(9, 1.0);
+  q.ggv_brake = {10.0};
+  auto prof = solve_velocity_profile(kappa, ds, false, q);
+  EXPECT_NE(prof.reason.find("ggv_brake"), std::string::npos) << prof.reason;
+  q = ggv_params(10.0, 18.0, 5.0, 5.0, 10.0, 10.0);
+  q.ggv_speed = {10.0, 10.0};
+  prof = solve_velocity_profile(kappa, ds, false, q);
+  EXPECT_NE(prof.reason.find("ascending"), std::string::npos) << prof.reason;
+  q = ggv_params(10.0, -1.0, 5.0, 5.0, 10.0, 10.0);
+  prof = solve_velocity_profile(kappa, ds, false, q);
+  EXPECT_NE(prof.reason.find("ggv_lateral[1]"), std::string::npos) << prof.reason;
+}
+
 }  // namespace
 }  // namespace paddock::planning

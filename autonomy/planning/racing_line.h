@@ -1,0 +1,78 @@
+#pragma once
+// the minimum-curvature racing line: the path between two boundaries that
+// bends least, sum of kappa^2 ds, keeping a clearance to both. It is the
+// classic approximation of the minimum-lap-time line (Braghin et al. 2008;
+// TUM's global_racetrajectory_optimization solves it as a QP on spline
+// coefficients): the less a line bends, the faster its corners, and on FS
+// tracks, which are mostly corners, it is within a few per cent of the true
+// minimum-time line.
+//
+// Formulation: reference points r_i every `step` metres along a reference
+// line (a centreline), each free to move along its normal n_i by an offset
+// a_i (> 0 to the left), p_i = r_i + a_i n_i, a_i within [lo_i, hi_i] where
+// lo_i and hi_i keep p_i `clearance` from the right and left boundary along
+// the normal. The cost is the sum over i of kappa_i^2 ds_i with kappa_i the
+// curvature of the circle through p_i-1, p_i, p_i+1 (Menger curvature), a
+// smooth non-linear least-squares problem solved with Ceres (bounded
+// Levenberg-Marquardt, sparse normal Cholesky on its banded Jacobian),
+// starting from the reference (a_i = 0).
+#include <string>
+#include <vector>
+
+#include "autonomy/common/geometry.h"
+#include "autonomy/common/params.h"
+
+namespace paddock::planning {
+
+struct RacingLineParams {
+  // the car's centre keeps this far from each boundary line (the lines
+  // joining consecutive cones of one colour): half the car's width (0.7 m)
+  // and a margin for tracking errors
+  double clearance = 1.0;
+  // spacing of the reference points: about the wheelbase, so that the line
+  // cannot bend at a scale the car cannot follow, and fine enough for the
+  // tightest FS hairpins (centreline radius ~2.5 m)
+  double step = 1.0;
+  // boundaries further than this along a normal count as absent (m): the
+  // point may not leave the reference on that side
+  double reach = 15.0;
+  int max_iterations = 200;
+
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(clearance), {"m", params::at_least(0.0), "the line keeps this far from each boundary"});
+    v(PADDOCK_PARAM(step), {"m", params::in(0.1, 10.0), "spacing of the optimised points"});
+    v(PADDOCK_PARAM(reach), {"m", params::above(0.0), "a boundary further than this along a normal is not used"});
+    v(PADDOCK_PARAM(max_iterations), {"", params::in(1, 10000), "solver iterations at most"});
+  }
+};
+
+struct RacingLine {
+  std::vector<Vec2> points;     // the optimised line, one point per reference point, driving order
+  std::vector<Vec2> reference;  // the reference points it started from
+  std::vector<double> offset;   // a_i (m, > 0 left of the reference)
+  std::vector<double> lower;    // the offset's bounds (m)
+  std::vector<double> upper;
+  double cost_reference = 0.0;  // sum kappa^2 ds of the reference points (1/m)
+  double cost = 0.0;            // and of the optimised line
+  int iterations = 0;
+  std::string reason;           // empty when ok
+
+  bool ok() const { return reason.empty(); }
+};
+
+// the minimum-curvature line along `reference` (driving order; closed: a lap,
+// first point not repeated) between `left` and `right` (the boundary
+// polylines, closed like the reference). Where the boundaries are closer
+// together than twice the clearance, the point stays midway between them.
+// Fewer than 3 (closed) or 4 (open) resampled points, NaN or bad parameters
+// give a reason; nothing throws. Open lines keep their end points' offsets
+// free but have no curvature term at the ends.
+RacingLine min_curvature_line(const std::vector<Vec2>& reference, const std::vector<Vec2>& left,
+                              const std::vector<Vec2>& right, bool closed, const RacingLineParams& params = {});
+
+// sum kappa_i^2 ds_i of a polyline with Menger curvature (the cost above):
+// closed, every point; open, the inner points
+double curvature_cost(const std::vector<Vec2>& points, bool closed);
+
+}  // namespace paddock::planning
