@@ -148,7 +148,7 @@ Figure draw_track_map(const TrackMapData& d, const FigureStyle& style) {
     legend.push_back(e);
   }
   if (!d.trajectory.empty()) {
-    legend.push_back({has_speed ? LegendEntry::Kind::Gradient : LegendEntry::Kind::Line, "trajectory", kTabRed, {},
+    legend.push_back({has_speed ? LegendEntry::Kind::Gradient : LegendEntry::Kind::Line, d.trajectory_label, kTabRed, {},
                       2.2});
   }
   bool present[5] = {false, false, false, false, false};

@@ -102,6 +102,7 @@ struct TrackMapData {
   std::vector<double> speed;                 // ... coloured by speed (m/s), same size; a colour bar
                                              // over [min, max] ([v - 0.5, v + 0.5] for one speed v);
                                              // empty: one colour, no colour bar; NaN: a gap
+  std::string trajectory_label = "trajectory";  // its legend entry
   std::vector<MapLayer> layers;              // optional layers
   std::vector<Cone> estimated_cones;         // optional: a cone map estimated by SLAM (hollow markers)
 };

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 
 namespace paddock {
 
@@ -105,6 +106,21 @@ std::optional<double> crossing_right_to_left(Vec2 p0, Vec2 p1, const Segment& g)
   const double u = dot(hit - g.a, d) / len2;
   if (u < 0.0 || u > 1.0) return std::nullopt;
   return f;
+}
+
+double polyline_distance(const std::vector<Vec2>& pts, bool closed, Vec2 q) {
+  double best = std::numeric_limits<double>::infinity();
+  const std::size_t n = pts.size();
+  if (n < 2) return best;
+  for (std::size_t i = 0; i < (closed ? n : n - 1); ++i) {
+    const Vec2 a = pts[i], b = pts[(i + 1) % n];
+    // skip segments whose bounding box is farther than the best so far
+    const double dx = std::max({std::min(a.x, b.x) - q.x, q.x - std::max(a.x, b.x), 0.0});
+    const double dy = std::max({std::min(a.y, b.y) - q.y, q.y - std::max(a.y, b.y), 0.0});
+    if (dx >= best || dy >= best) continue;
+    best = std::min(best, point_segment_distance(q, a, b));
+  }
+  return best;
 }
 
 double point_segment_distance(Vec2 q, Vec2 a, Vec2 b) {

@@ -47,4 +47,8 @@ std::optional<double> crossing_right_to_left(Vec2 p0, Vec2 p1, const Segment& g)
 // distance from q to the segment a-b
 double point_segment_distance(Vec2 q, Vec2 a, Vec2 b);
 
+// distance from q to the nearest segment of a polyline (closed: with the
+// segment back to the first point); infinite for fewer than 2 points
+double polyline_distance(const std::vector<Vec2>& pts, bool closed, Vec2 q);
+
 }  // namespace paddock

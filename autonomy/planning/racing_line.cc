@@ -4,10 +4,15 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <map>
+#include <utility>
 #include <memory>
 #include <optional>
 
 #include <ceres/ceres.h>
+#include <IpIpoptApplication.hpp>
+#include <IpSolveStatistics.hpp>
+#include <IpTNLP.hpp>
 
 #include "autonomy/common/polyline.h"
 
@@ -41,20 +46,21 @@ double ray_distance(Vec2 o, Vec2 d, const std::vector<Vec2>& line, bool closed) 
 }
 
 // the curvature of the circle through three points, 2 (a x b) / (|a| |b| |a + b|),
-// times sqrt(ds): its square summed is sum kappa^2 ds (curvature_cost)
+// times sqrt(ds) with ds half the two chords (the length the point stands
+// for): its square summed is sum kappa^2 ds (curvature_cost). Templated for
+// Ceres' automatic differentiation, which gives each residual's gradient.
 struct MengerResidual {
   Vec2 r0, r1, r2;  // reference points
   Vec2 n0, n1, n2;  // their unit normals
 
   template <class T>
   bool operator()(const T* a0, const T* a1, const T* a2, T* residual) const {
+    using std::sqrt;
     const T x0 = r0.x + a0[0] * n0.x, y0 = r0.y + a0[0] * n0.y;
     const T x1 = r1.x + a1[0] * n1.x, y1 = r1.y + a1[0] * n1.y;
     const T x2 = r2.x + a2[0] * n2.x, y2 = r2.y + a2[0] * n2.y;
     const T ax = x1 - x0, ay = y1 - y0, bx = x2 - x1, by = y2 - y1, cx = x2 - x0, cy = y2 - y0;
-    using std::sqrt;
     const T la = sqrt(ax * ax + ay * ay), lb = sqrt(bx * bx + by * by), lc = sqrt(cx * cx + cy * cy);
-    // ds: half the two chords, the length this point stands for
     residual[0] = sqrt(0.5 * (la + lb)) * 2.0 * (ax * by - ay * bx) / (la * lb * lc);
     return true;
   }
@@ -64,6 +70,151 @@ double menger(Vec2 p0, Vec2 p1, Vec2 p2) {
   const Vec2 a = p1 - p0, b = p2 - p1, c = p2 - p0;
   const double den = norm(a) * norm(b) * norm(c);
   return den > 0.0 ? 2.0 * cross(a, b) / den : 0.0;
+}
+
+// rounds of tightening the bounds where the Euclidean clearance falls short
+constexpr int kClearanceRounds = 4;
+// m: a shortfall smaller than this is left alone
+constexpr double kClearanceTolerance = 0.005;
+
+// the problem for IPOPT: minimise f(a) = sum_k r_k(a)^2 within the bounds,
+// no other constraints. Each residual r_k touches three neighbouring offsets;
+// its gradient comes from Ceres' automatic differentiation. The Hessian
+// given is the Gauss-Newton one, 2 sum_k J_k^T J_k (positive semi-definite,
+// the curvature residuals' own second derivatives left out), a band of
+// width 2 round the loop.
+class MinCurvatureNlp : public Ipopt::TNLP {
+ public:
+  using Index = Ipopt::Index;
+  using Number = Ipopt::Number;
+
+  MinCurvatureNlp(const std::vector<Vec2>& r, const std::vector<Vec2>& normal, bool closed,
+                  const std::vector<double>& lower, const std::vector<double>& upper, std::vector<double>& offset)
+      : lower_(lower), upper_(upper), offset_(offset) {
+    const std::size_t n = r.size();
+    for (std::size_t i = closed ? 0 : 1; i < (closed ? n : n - 1); ++i) {
+      const std::size_t a = (i + n - 1) % n, c = (i + 1) % n;
+      residuals_.push_back({{a, i, c},
+                            std::make_unique<ceres::AutoDiffCostFunction<MengerResidual, 1, 1, 1, 1>>(
+                                new MengerResidual{r[a], r[i], r[c], normal[a], normal[i], normal[c]})});
+    }
+    // the Hessian's lower triangle: every pair of offsets one residual joins
+    for (Residual& res : residuals_) {
+      for (int p = 0; p < 3; ++p) {
+        for (int q = 0; q < 3; ++q) {
+          const std::size_t i = res.index[p], j = res.index[q];
+          if (i < j) continue;
+          const auto [it, added] = hessian_slot_.try_emplace({i, j}, hessian_slot_.size());
+          res.slot[p][q] = it->second;
+        }
+      }
+    }
+  }
+
+  bool get_nlp_info(Index& n, Index& m, Index& nnz_jac_g, Index& nnz_h_lag, IndexStyleEnum& style) override {
+    n = static_cast<Index>(offset_.size());
+    m = 0;
+    nnz_jac_g = 0;
+    nnz_h_lag = static_cast<Index>(hessian_slot_.size());
+    style = C_STYLE;
+    return true;
+  }
+  bool get_bounds_info(Index n, Number* x_l, Number* x_u, Index, Number*, Number*) override {
+    for (Index i = 0; i < n; ++i) x_l[i] = lower_[static_cast<std::size_t>(i)], x_u[i] = upper_[static_cast<std::size_t>(i)];
+    return true;
+  }
+  bool get_starting_point(Index n, bool, Number* x, bool, Number*, Number*, Index, bool, Number*) override {
+    std::copy(offset_.begin(), offset_.begin() + n, x);
+    return true;
+  }
+  bool eval_f(Index, const Number* x, bool, Number& f) override {
+    f = 0.0;
+    for (const Residual& res : residuals_) {
+      const double r = evaluate(res, x, nullptr);
+      f += r * r;
+    }
+    return std::isfinite(f);
+  }
+  bool eval_grad_f(Index n, const Number* x, bool, Number* grad) override {
+    std::fill(grad, grad + n, 0.0);
+    double j[3];
+    for (const Residual& res : residuals_) {
+      const double r = evaluate(res, x, j);
+      for (int p = 0; p < 3; ++p) grad[res.index[p]] += 2.0 * r * j[p];
+    }
+    return true;
+  }
+  bool eval_g(Index, const Number*, bool, Index, Number*) override { return true; }
+  bool eval_jac_g(Index, const Number*, bool, Index, Index, Index*, Index*, Number*) override { return true; }
+  bool eval_h(Index, const Number* x, bool, Number obj_factor, Index, const Number*, bool, Index nele, Index* row,
+              Index* col, Number* values) override {
+    if (values == nullptr) {
+      for (const auto& [pair, slot] : hessian_slot_) {
+        row[slot] = static_cast<Index>(pair.first);
+        col[slot] = static_cast<Index>(pair.second);
+      }
+      return true;
+    }
+    std::fill(values, values + nele, 0.0);
+    double j[3];
+    for (const Residual& res : residuals_) {
+      evaluate(res, x, j);
+      for (int p = 0; p < 3; ++p)
+        for (int q = 0; q < 3; ++q)
+          if (res.index[p] >= res.index[q]) values[res.slot[p][q]] += obj_factor * 2.0 * j[p] * j[q];
+    }
+    return true;
+  }
+  void finalize_solution(Ipopt::SolverReturn, Index n, const Number* x, const Number*, const Number*, Index,
+                         const Number*, const Number*, Number, const Ipopt::IpoptData*,
+                         Ipopt::IpoptCalculatedQuantities*) override {
+    std::copy(x, x + n, offset_.begin());
+  }
+
+ private:
+  struct Residual {
+    std::size_t index[3];
+    std::unique_ptr<ceres::CostFunction> cost;
+    std::size_t slot[3][3] = {};
+  };
+
+  // r_k, and its gradient with respect to its three offsets when j is given
+  static double evaluate(const Residual& res, const Number* x, double* j) {
+    const double* params[3] = {&x[res.index[0]], &x[res.index[1]], &x[res.index[2]]};
+    double r = 0.0;
+    double* jac[3] = {j, j ? j + 1 : nullptr, j ? j + 2 : nullptr};
+    res.cost->Evaluate(params, &r, j ? jac : nullptr);
+    return r;
+  }
+
+  const std::vector<double>& lower_;
+  const std::vector<double>& upper_;
+  std::vector<double>& offset_;
+  std::vector<Residual> residuals_;
+  std::map<std::pair<std::size_t, std::size_t>, std::size_t> hessian_slot_;
+};
+
+// one solve from `offset` (within the bounds); returns IPOPT's iterations,
+// -1 when it failed (the offsets are then left as they were)
+int solve(const std::vector<Vec2>& r, const std::vector<Vec2>& normal, bool closed, int max_iterations,
+          const std::vector<double>& lower, const std::vector<double>& upper, std::vector<double>& offset) {
+  std::vector<double> x = offset;
+  Ipopt::SmartPtr<MinCurvatureNlp> nlp = new MinCurvatureNlp(r, normal, closed, lower, upper, x);
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  app->Options()->SetIntegerValue("print_level", 0);
+  app->Options()->SetStringValue("sb", "yes");  // no banner
+  app->Options()->SetIntegerValue("max_iter", max_iterations);
+  app->Options()->SetNumericValue("tol", 1e-10);
+  app->Options()->SetStringValue("mu_strategy", "adaptive");
+  app->Options()->SetStringValue("honor_original_bounds", "yes");
+  if (app->Initialize() != Ipopt::Solve_Succeeded) return -1;
+  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(GetRawPtr(nlp)));
+  const bool usable = status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level ||
+                      status == Ipopt::Maximum_Iterations_Exceeded;
+  if (!usable || !std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); })) return -1;
+  for (std::size_t i = 0; i < x.size(); ++i) offset[i] = std::clamp(x[i], lower[i], upper[i]);
+  Ipopt::SmartPtr<Ipopt::SolveStatistics> stats = app->Statistics();
+  return IsValid(stats) ? stats->IterationCount() : 0;
 }
 
 }  // namespace
@@ -130,46 +281,58 @@ RacingLine min_curvature_line(const std::vector<Vec2>& reference, const std::vec
     out.upper[i] = hi;
   }
 
-  // the problem: one offset per point, one curvature residual per inner point
+  // the problem: one offset per point, one curvature residual per inner
+  // point. The bounds come from distances along the normals; where a
+  // boundary bends towards a point, the true (Euclidean) distance of the
+  // solved point can be shorter, so that side's bound is tightened by the
+  // shortfall and the problem solved again from there (a few rounds)
   out.offset.assign(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) out.offset[i] = std::clamp(0.0, out.lower[i], out.upper[i]);
-  ceres::Problem::Options problem_options;
-  ceres::Problem problem(problem_options);
-  for (std::size_t i = closed ? 0 : 1; i < (closed ? n : n - 1); ++i) {
-    const std::size_t a = (i + n - 1) % n, c = (i + 1) % n;
-    auto* cost = new ceres::AutoDiffCostFunction<MengerResidual, 1, 1, 1, 1>(
-        new MengerResidual{r[a], r[i], r[c], normal[a], normal[i], normal[c]});
-    problem.AddResidualBlock(cost, nullptr, &out.offset[a], &out.offset[i], &out.offset[c]);
-  }
-  for (std::size_t i = 0; i < n; ++i) {
-    double* a = &out.offset[i];
-    if (out.upper[i] - out.lower[i] < 1e-9) {
-      problem.SetParameterBlockConstant(a);
-    } else {
-      problem.SetParameterLowerBound(a, 0, out.lower[i]);
-      problem.SetParameterUpperBound(a, 0, out.upper[i]);
+  for (int round = 0; round < kClearanceRounds; ++round) {
+    const int iterations = solve(r, normal, closed, params.max_iterations, out.lower, out.upper, out.offset);
+    if (iterations < 0) {
+      out.reason = "racing line: the optimiser failed";
+      return out;
     }
+    out.iterations += iterations;
+    // each point and the point half-way to the next (a line wrapping round a
+    // cone at exactly the clearance comes closer between its points); a
+    // shortfall half-way tightens both ends
+    bool tightened = false;
+    const auto tighten = [&](std::size_t i, double short_left, double short_right) {
+      if (short_left > kClearanceTolerance && out.upper[i] - short_left >= out.lower[i]) {
+        out.upper[i] -= short_left;
+        out.offset[i] = std::min(out.offset[i], out.upper[i]);
+        tightened = true;
+      }
+      if (short_right > kClearanceTolerance && out.lower[i] + short_right <= out.upper[i]) {
+        out.lower[i] += short_right;
+        out.offset[i] = std::max(out.offset[i], out.lower[i]);
+        tightened = true;
+      }
+    };
+    std::vector<double> short_left(n), short_right(n), mid_left(n, 0.0), mid_right(n, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec2 q = r[i] + out.offset[i] * normal[i];
+      short_left[i] = params.clearance - polyline_distance(left, closed, q);
+      short_right[i] = params.clearance - polyline_distance(right, closed, q);
+      if (!closed && i + 1 == n) continue;
+      const std::size_t j = (i + 1) % n;
+      const Vec2 m = 0.5 * (q + r[j] + out.offset[j] * normal[j]);
+      mid_left[i] = params.clearance - polyline_distance(left, closed, m);
+      mid_right[i] = params.clearance - polyline_distance(right, closed, m);
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t h = closed ? (i + n - 1) % n : (i == 0 ? 0 : i - 1);  // the half-way point before
+      tighten(i, std::max({short_left[i], mid_left[i], mid_left[h]}), std::max({short_right[i], mid_right[i], mid_right[h]}));
+    }
+    if (!tightened) break;
   }
-  ceres::Solver::Options options;
-  options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-  options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
-  options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  options.max_num_iterations = params.max_iterations;
-  options.function_tolerance = 1e-13;
-  options.gradient_tolerance = 1e-12;
-  options.parameter_tolerance = 1e-12;
-  options.num_threads = 1;
-  options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(options, &problem, &summary);
-  out.iterations = static_cast<int>(summary.iterations.size());
 
   out.reference = r;
   out.points.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double a = std::clamp(out.offset[i], out.lower[i], out.upper[i]);
-    out.offset[i] = a;
-    out.points[i] = r[i] + a * normal[i];
+    out.points[i] = r[i] + out.offset[i] * normal[i];
   }
   out.cost_reference = curvature_cost(r, closed);
   out.cost = curvature_cost(out.points, closed);

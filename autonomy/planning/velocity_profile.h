@@ -74,11 +74,11 @@ struct VelocityProfileParams {
   // simulated car and prints these four lines. Each combines with the
   // others through the g-g shape (exponent) and turn_accel_scale as the
   // constant limits do. The defaults are the default car's
-  // (scenarios/vehicles/default.ini), rounded down.
-  std::vector<double> ggv_speed = {0.0, 10.0, 15.0, 20.0, 25.0, 30.0, 34.0};
-  std::vector<double> ggv_lateral = {16.0, 16.5, 17.0, 17.5, 18.0, 18.5, 18.5};
-  std::vector<double> ggv_accel = {14.5, 14.5, 14.2, 11.1, 8.7, 6.4, 0.0};
-  std::vector<double> ggv_brake = {14.4, 14.7, 15.3, 16.2, 17.5, 19.0, 19.0};
+  // (scenarios/vehicles/default.ini) as `paddock report vehicle` prints them.
+  std::vector<double> ggv_speed = {0.0, 5.0, 10.0, 15.0, 20.0, 25.0, 30.0, 34.26};
+  std::vector<double> ggv_lateral = {16.61, 16.67, 16.84, 17.08, 17.52, 18.04, 18.58, 18.58};
+  std::vector<double> ggv_accel = {14.60, 14.60, 14.57, 14.29, 11.18, 8.78, 6.45, 0.0};
+  std::vector<double> ggv_brake = {14.40, 14.40, 14.73, 15.39, 16.29, 17.55, 19.01, 19.01};
   // the shares of the envelope planned with (limits = ggv): the rest is the
   // reserve for tracking, localisation and perception errors
   double margin_lateral = 0.8;

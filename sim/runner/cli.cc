@@ -10,6 +10,7 @@
 #include "render/figures.h"
 #include "sim/runner/files.h"
 #include "sim/runner/plots.h"
+#include "sim/runner/limit_report.h"
 #include "sim/runner/reports.h"
 #include "sim/runner/report.h"
 #include "sim/runner/scenario.h"
@@ -70,6 +71,13 @@ const char* kUsage =
     "      braking from 100 km/h, the skidpad limit and the g-g-v envelope; writes\n"
     "      DIR/vehicle_report.json and DIR/ggv.png (CAR.ini defaults to\n"
     "      scenarios/vehicles/default.ini, DIR to runs/vehicle_<car name>)\n"
+    "  paddock report limit SCENARIO.ini [--clearance M] [--set section.key=value]...\n"
+    "              [--out DIR] [--map-size N] [--dpi D]\n"
+    "      the fastest flying lap the scenario's car can drive on its circuit: its\n"
+    "      g-g-v measured on the model, a QSS forward-backward profile on the\n"
+    "      centreline and on the minimum-curvature line M m (default 1) from the\n"
+    "      boundaries; writes DIR/limit_report.json, DIR/limit_lines.csv (both lines'\n"
+    "      samples) and DIR/limit.png (DIR defaults to runs/limit_<scenario name>)\n"
     "  paddock keys\n"
     "      every scenario key (section = struct path) with its default, unit, range and\n"
     "      meaning, as the README's Markdown table\n"
@@ -211,8 +219,51 @@ int cmd_report_vehicle(const std::vector<std::string>& args) {
   return 0;
 }
 
+// report limit SCENARIO.ini [--clearance M] [--set k=v]... [--out DIR] [plot options]
+int cmd_report_limit(const std::vector<std::string>& args) {
+  std::string scenario_path, out_dir;
+  std::vector<std::string> overrides;
+  double clearance = kLimitClearance;
+  PlotOptions options;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (plot_option(args, i, options)) continue;
+    if (a == "--out" || a == "--set" || a == "--clearance") {
+      if (i + 1 >= args.size()) throw UserError(a + " needs a value");
+      const std::string& value = args[++i];
+      if (a == "--out") out_dir = value;
+      else if (a == "--set") overrides.push_back(value);
+      else {
+        char* end = nullptr;
+        clearance = std::strtod(value.c_str(), &end);
+        if (value.empty() || *end != '\0' || !std::isfinite(clearance) || clearance < 0.0)
+          throw UserError("--clearance: expected a distance >= 0 m, got '" + value + "'");
+      }
+    } else if (!a.empty() && a[0] == '-') {
+      throw UserError("report limit: unknown option " + a + "\n" + kUsage);
+    } else if (scenario_path.empty()) {
+      scenario_path = a;
+    } else {
+      throw UserError("report limit: more than one scenario given: " + scenario_path + " and " + a);
+    }
+  }
+  if (scenario_path.empty()) throw UserError(std::string("report limit needs a scenario file\n") + kUsage);
+  const Scenario scenario = load_scenario(scenario_path, overrides);
+  const world::TrackModel track = world::build_track(load_track_file(scenario.track_path));
+  if (out_dir.empty()) out_dir = "runs/limit_" + std::filesystem::path(scenario_path).stem().string();
+  const auto start = std::chrono::steady_clock::now();
+  const LimitReport report = limit_report(scenario.vehicle, track, scenario_path, clearance);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::vector<std::string> files = write_limit_report(report, track, out_dir, options);
+  std::cout << limit_report_text(report) << "  output      " << files[0] << ", " << files[1] << "\n  figure      "
+            << files[2] << "\n"
+            << "  speed       " << fixed(wall, 3) << " s\n";
+  return 0;
+}
+
 int cmd_report(const std::vector<std::string>& args) {
   if (!args.empty() && args[0] == "vehicle") return cmd_report_vehicle({args.begin() + 1, args.end()});
+  if (!args.empty() && args[0] == "limit") return cmd_report_limit({args.begin() + 1, args.end()});
   if (args.size() >= 2 && args[0] == "smoothing" && args.size() == 2) {
     std::cout << report_smoothing(args[1]);
     return 0;
@@ -226,7 +277,7 @@ int cmd_report(const std::vector<std::string>& args) {
     std::cout << report_controllers(args[1], overrides);
     return 0;
   }
-  throw UserError(std::string("report needs 'controllers SCENARIO', 'smoothing TRACK' or 'vehicle [CAR]'\n") + kUsage);
+  throw UserError(std::string("report needs 'controllers SCENARIO', 'smoothing TRACK', 'vehicle [CAR]' or 'limit SCENARIO'\n") + kUsage);
 }
 
 // a command's folder and plot options (args from `first` on); `what` names

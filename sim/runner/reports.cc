@@ -35,15 +35,6 @@ Stats stats_of(const std::vector<double>& v) {
   return s;
 }
 
-// distance from q to the nearest segment of a closed polyline
-double distance_to_loop(const std::vector<Vec2>& loop, Vec2 q) {
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < loop.size(); ++i) {
-    best = std::min(best, point_segment_distance(q, loop[i], loop[(i + 1) % loop.size()]));
-  }
-  return best;
-}
-
 }  // namespace
 
 std::string report_controllers(const std::string& scenario_path, const std::vector<std::string>& overrides) {
@@ -120,8 +111,8 @@ std::string report_smoothing(const std::string& track_path) {
       ay.push_back(25.0 * std::abs(a.curvature));
       const double ds = t.length / static_cast<double>(t.points.size());
       cvr.push_back(std::abs(b.curvature - a.curvature) / ds);
-      min_boundary = std::min({min_boundary, distance_to_loop(track.left, a.position()),
-                               distance_to_loop(track.right, a.position())});
+      min_boundary = std::min({min_boundary, polyline_distance(track.left, true, a.position()),
+                               polyline_distance(track.right, true, a.position())});
     }
     const Stats lateral = stats_of(ay), curvature_rate = stats_of(cvr);
     ours.push_back({planning::lap_time(t), lateral.max, lateral.mean, lateral.std, curvature_rate.max, curvature_rate.mean,

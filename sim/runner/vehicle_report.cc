@@ -370,6 +370,14 @@ GgvRow ggv_row(TestCar& car, double v, double lateral_guess) {
   return row;
 }
 
+// the g-g-v from kGgvStep to the top speed
+std::vector<GgvRow> ggv_rows(TestCar& car, double top_speed) {
+  std::vector<GgvRow> rows;
+  const double v_max = std::min(top_speed, kGgvMaxSpeed) + 1e-9;
+  for (double v = kGgvStep; v <= v_max; v += kGgvStep) rows.push_back(ggv_row(car, v, rows.empty() ? 0.0 : rows.back().lateral));
+  return rows;
+}
+
 }  // namespace
 
 VehicleReport vehicle_report(const VehicleParams& p, const std::string& source) {
@@ -380,15 +388,91 @@ VehicleReport vehicle_report(const VehicleParams& p, const std::string& source) 
   std::tie(r.full_brake, r.best_brake) = stops_from(car, kBrakingSpeed);
   car.driver_scale = driver_scale(car);
   r.skidpad = skidpad_limit(car);
-  const double v_max = std::min(r.acceleration.top_speed, kGgvMaxSpeed) + 1e-9;
-  for (double v = kGgvStep; v <= v_max; v += kGgvStep) {
-    r.ggv.push_back(ggv_row(car, v, r.ggv.empty() ? 0.0 : r.ggv.back().lateral));
-  }
+  r.ggv = ggv_rows(car, r.acceleration.top_speed);
   r.simulated_time = car.simulated;
   return r;
 }
 
+GgvMeasurement measure_ggv(const VehicleParams& p) {
+  GgvMeasurement m;
+  TestCar car{p};
+  const AccelerationRun a = full_throttle_from_rest(car);
+  m.top_speed = a.top_speed;
+  car.driver_scale = driver_scale(car);
+  m.rows = ggv_rows(car, a.top_speed);
+  m.simulated_time = car.simulated;
+  return m;
+}
+
+planning::VelocityProfileParams ggv_envelope(const std::vector<GgvRow>& rows, double top_speed) {
+  planning::VelocityProfileParams e;
+  e.limits = planning::VelocityProfileParams::Ggv;
+  e.margin_lateral = 1.0;
+  e.margin_longitudinal = 1.0;
+  e.turn_accel_scale = 1.0;
+  e.v_max = std::max(top_speed, 0.1);
+  if (rows.empty()) {
+    // a car that never reaches the first speed: its constant defaults say nothing; keep them
+    return e;
+  }
+  // the grip line ay = a + b v^2 (downforce grows with v^2) through the
+  // grip-limited rows, by least squares; one row: flat
+  double s0 = 0, s1 = 0, s2 = 0, t0 = 0, t1 = 0;
+  int grip = 0;
+  for (const GgvRow& r : rows) {
+    if (r.lateral_limit != "grip") continue;
+    const double x = r.speed * r.speed;
+    s0 += 1, s1 += x, s2 += x * x, t0 += r.lateral, t1 += x * r.lateral;
+    ++grip;
+  }
+  double a = 0.0, b = 0.0;
+  if (grip >= 2 && s0 * s2 - s1 * s1 > 0.0) {
+    b = (s0 * t1 - s1 * t0) / (s0 * s2 - s1 * s1);
+    a = (t0 - b * s1) / s0;
+  } else if (grip == 1) {
+    a = t0;
+  }
+  const auto lateral = [&](const GgvRow& r) {
+    // a row bounded by the steering lock says how tight the car turns, not
+    // how hard it grips: the grip line's value there (the lock is a limit of
+    // the path's curvature, not of its speed)
+    if (r.lateral_limit == "steering lock" && grip > 0) return std::max(r.lateral, a + b * r.speed * r.speed);
+    return r.lateral;
+  };
+  // from rest: the first row's values, the grip line's at 0
+  e.ggv_speed = {0.0};
+  e.ggv_lateral = {grip > 0 ? a : rows.front().lateral};
+  e.ggv_accel = {rows.front().acceleration};
+  e.ggv_brake = {rows.front().braking};
+  for (const GgvRow& r : rows) {
+    e.ggv_speed.push_back(r.speed);
+    e.ggv_lateral.push_back(lateral(r));
+    e.ggv_accel.push_back(r.acceleration);
+    e.ggv_brake.push_back(r.braking);
+  }
+  // the top speed: no acceleration left
+  if (top_speed > e.ggv_speed.back() + 0.1) {
+    e.ggv_speed.push_back(top_speed);
+    e.ggv_lateral.push_back(e.ggv_lateral.back());
+    e.ggv_accel.push_back(0.0);
+    e.ggv_brake.push_back(e.ggv_brake.back());
+  }
+  return e;
+}
+
+std::string ggv_ini(const planning::VelocityProfileParams& e) {
+  const auto list = [](const std::vector<double>& v) {
+    std::string t;
+    for (double x : v) t += (t.empty() ? "" : ", ") + fixed(x, 2);
+    return t;
+  };
+  return "[planning.reference.profile]\nlimits = ggv\nggv_speed = " + list(e.ggv_speed) +
+         "\nggv_lateral = " + list(e.ggv_lateral) + "\nggv_accel = " + list(e.ggv_accel) +
+         "\nggv_brake = " + list(e.ggv_brake) + "\n";
+}
+
 namespace {
+
 
 std::string in_g(double a) { return fixed(a / kGravity, 2); }
 
@@ -443,6 +527,9 @@ std::string vehicle_report_text(const VehicleReport& r) {
     o << "not held even at 4 m/s\n";
   }
   o << ggv_text(r.ggv);
+  o << "  for the stack: its planned envelope (limits = ggv) as measured here, with margins of its own\n";
+  std::istringstream lines(ggv_ini(ggv_envelope(r.ggv, a.top_speed)));
+  for (std::string line; std::getline(lines, line);) o << "    " << line << "\n";
   return o.str();
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/planning/velocity_profile.h"
 #include "render/figures.h"
 #include "sim/runner/plots.h"
 #include "sim/vehicle/vehicle.h"
@@ -71,6 +72,25 @@ struct VehicleReport {
 // runs every experiment on the car; throws UserError when the model's state
 // stops being finite (a car the 1 ms step cannot integrate)
 VehicleReport vehicle_report(const vehicle::VehicleParams& p, const std::string& source);
+
+// the g-g-v alone (what `paddock report limit` needs): the top speed, then
+// the rows as vehicle_report measures them
+struct GgvMeasurement {
+  double top_speed = 0.0;        // m/s
+  std::vector<GgvRow> rows;
+  double simulated_time = 0.0;   // s
+};
+GgvMeasurement measure_ggv(const vehicle::VehicleParams& p);
+
+// the measured g-g-v as the velocity profile's envelope (limits = ggv,
+// margins 1, turn_accel_scale 1, v_max the top speed): a node at rest (the
+// first row's acceleration and braking), one per row, and one at the top
+// speed with no acceleration left. Rows whose lateral limit is the steering
+// lock take the grip line a + b v^2 fitted to the grip-limited rows (the
+// lock bounds the path's curvature, not the speed on it).
+planning::VelocityProfileParams ggv_envelope(const std::vector<GgvRow>& rows, double top_speed);
+// the envelope as the lines of a scenario's [planning.reference.profile]
+std::string ggv_ini(const planning::VelocityProfileParams& envelope);
 
 // the readable table `paddock report vehicle` prints
 std::string vehicle_report_text(const VehicleReport& r);

@@ -143,7 +143,7 @@ void build_acceleration(TrackModel& m, const TrackFile& f, const ConeSets& cs) {
   // centreline: the axis from the start to the end of the layout
   const std::vector<Vec2> axis{o + u * a_start, o + u * a_max};
   m.centreline = resample(axis, false, kCentrelineSpacing);
-  for (const Vec2& q : m.centreline) m.width.push_back(distance_to(lside, false, q) + distance_to(rside, false, q));
+  for (const Vec2& q : m.centreline) m.width.push_back(polyline_distance(lside, false, q) + polyline_distance(rside, false, q));
 
   std::vector<Vec2> polygon = lside;
   polygon.insert(polygon.end(), rside.rbegin(), rside.rend());

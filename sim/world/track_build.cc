@@ -19,19 +19,6 @@ double median(std::vector<double> v) {
 }
 
 // distance from q to a polyline (brute force over its segments)
-double distance_to(const std::vector<Vec2>& p, bool closed, Vec2 q) {
-  double best = std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < segment_count(p, closed); ++i) {
-    const Vec2 a = p[i], b = p[(i + 1) % p.size()];
-    // skip segments whose bounding box is farther than the best so far
-    const double dx = std::max({std::min(a.x, b.x) - q.x, q.x - std::max(a.x, b.x), 0.0});
-    const double dy = std::max({std::min(a.y, b.y) - q.y, q.y - std::max(a.y, b.y), 0.0});
-    if (dx >= best || dy >= best) continue;
-    best = std::min(best, point_segment_distance(q, a, b));
-  }
-  return best;
-}
-
 // a pair of posts as a gate whose left post is on the left of `heading`
 Segment gate_from_posts(Vec2 p, Vec2 q, Vec2 heading) {
   const Vec2 mid = (p + q) * 0.5;

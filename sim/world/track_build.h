@@ -45,8 +45,6 @@ inline std::size_t segment_count(const std::vector<Vec2>& p, bool closed) {
 // the median of v (the upper one of an even count); 0 when empty
 double median(std::vector<double> v);
 
-// distance from q to a polyline (brute force over its segments)
-double distance_to(const std::vector<Vec2>& p, bool closed, Vec2 q);
 
 // ---------------------------------------------------------------------------
 // cones by colour, doubles merged

@@ -331,8 +331,8 @@ Centre centre_between(const std::vector<Vec2>& left, const std::vector<Vec2>& ri
       for (std::size_t i = 0; i < c.size(); ++i) {
         if (!closed && (i == 0 || i + 1 == c.size())) continue;
         const Vec2 n = left_normal(tangent_at(c, closed, i));
-        const double dl = distance_to(left, closed, c[i]);
-        const double dr = distance_to(right, closed, c[i]);
+        const double dl = polyline_distance(left, closed, c[i]);
+        const double dr = polyline_distance(right, closed, c[i]);
         moved[i] = c[i] + n * (0.5 * (dl - dr));
       }
       c.swap(moved);
@@ -354,7 +354,7 @@ Centre centre_between(const std::vector<Vec2>& left, const std::vector<Vec2>& ri
   out.line = c;
   for (std::size_t i = 0; i < c.size(); ++i) {
     const Vec2 n = left_normal(tangent_at(c, closed, i));
-    const double dl = distance_to(left, closed, c[i]), dr = distance_to(right, closed, c[i]);
+    const double dl = polyline_distance(left, closed, c[i]), dr = polyline_distance(right, closed, c[i]);
     double wl = ray_hit(left, closed, c[i], n), wr = ray_hit(right, closed, c[i], -n);
     if (wl > 2.0 * dl + 0.5) wl = dl;
     if (wr > 2.0 * dr + 0.5) wr = dr;
@@ -460,7 +460,7 @@ void build_circuit(TrackModel& m, const TrackFile& f, const ConeSets& cs) {
     const double s0 = f.start ? arc.station(f.start->position()).along : 0.0;
     const double s = s0 + kStartToGate;
     const Vec2 p = arc.point(s), n = left_normal(arc.tangent(s));
-    const double dl = distance_to(m.left, true, p), dr = distance_to(m.right, true, p);
+    const double dl = polyline_distance(m.left, true, p), dr = polyline_distance(m.right, true, p);
     gates.push_back({p + n * (dl + kGatePostMargin), p - n * (dr + kGatePostMargin)});
   }
 

@@ -48,13 +48,6 @@ std::vector<Vec2> stadium(double length, double r, double d, double step = 0.25)
   return pts;
 }
 
-double min_distance(Vec2 q, const std::vector<Vec2>& line) {
-  double best = 1e300;
-  for (std::size_t i = 0; i < line.size(); ++i)
-    best = std::min(best, point_segment_distance(q, line[i], line[(i + 1) % line.size()]));
-  return best;
-}
-
 TEST(RacingLine, RingGivesTheOuterCircleLessTheClearance) {
   // an annulus 10..16 m driven anticlockwise (the inner ring on the left):
   // among closed curves in it, sum kappa^2 ds = 2 pi / R is least for the
@@ -115,13 +108,13 @@ TEST(RacingLine, KeepsTheClearanceFromBothBoundaries) {
     const RacingLine line = min_curvature_line(ref, left, right, true, p);
     ASSERT_TRUE(line.ok()) << line.reason;
     for (const Vec2& q : line.points) {
-      EXPECT_GE(min_distance(q, left), c - 1e-3);
-      EXPECT_GE(min_distance(q, right), c - 1e-3);
+      EXPECT_GE(polyline_distance(left, true, q), c - 1e-3);
+      EXPECT_GE(polyline_distance(right, true, q), c - 1e-3);
     }
     // and uses the room: on a stadium the least-bending line runs round the
     // outside (it never reaches the inner bound), touching its bound there
     double closest_right = 1e9;
-    for (const Vec2& q : line.points) closest_right = std::min(closest_right, min_distance(q, right));
+    for (const Vec2& q : line.points) closest_right = std::min(closest_right, polyline_distance(right, true, q));
     EXPECT_NEAR(closest_right, c, 0.02) << c;
   }
 }

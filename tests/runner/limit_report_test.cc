@@ -1,0 +1,174 @@
+// paddock report limit against closed forms (a ring circuit: the QSS lap of
+// the outer circle less the clearance), against its own constraints on a
+// real track (every sample within the envelope and the clearance, the
+// minimum-curvature line faster than the centreline), the envelope taken
+// from the vehicle report's rows, and the command's errors and files
+#include "sim/runner/limit_report.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "autonomy/common/polyline.h"
+#include "sim/runner/files.h"
+#include "sim/runner/scenario.h"
+#include "tests/runner/run_paddock.h"
+
+namespace paddock::runner {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+const std::string kRoot = PADDOCK_SOURCE_DIR;
+
+std::string scratch(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / "paddock_limit_report_test";
+  fs::create_directories(d);
+  return (d / name).string();
+}
+
+// a flat envelope: ay, then acceleration and braking at every speed
+planning::VelocityProfileParams flat_envelope(double ay, double acc, double brk) {
+  planning::VelocityProfileParams e;
+  e.limits = planning::VelocityProfileParams::Ggv;
+  e.ggv_speed = {0.0};
+  e.ggv_lateral = {ay};
+  e.ggv_accel = {acc};
+  e.ggv_brake = {brk};
+  e.margin_lateral = e.margin_longitudinal = 1.0;
+  e.turn_accel_scale = 1.0;
+  e.v_max = 100.0;
+  return e;
+}
+
+// a ring circuit: blue cones on r = 10 m (the left, driving anticlockwise),
+// yellow on r = 16 m, about 1.5 m apart, the start on the centreline
+world::TrackModel ring() {
+  std::ostringstream f;
+  f << "# start 13 0 " << kPi / 2.0 << "\ntag,x,y\n";
+  for (const auto& [tag, r] : {std::pair{"blue", 10.0}, std::pair{"yellow", 16.0}}) {
+    const int n = static_cast<int>(std::ceil(2.0 * kPi * r / 1.5));
+    for (int i = 0; i < n; ++i) {
+      const double a = 2.0 * kPi * i / n;
+      f << tag << "," << r * std::cos(a) << "," << r * std::sin(a) << "\n";
+    }
+  }
+  return world::build_track(world::parse_track(f.str(), "ring.csv"));
+}
+
+TEST(LimitLines, RingGivesTheQssLapOfTheOuterCircle) {
+  // the least-bending lap in the ring is the circle of R = 16 - clearance;
+  // at a flat 12 m/s^2 the QSS speed is sqrt(12 R) all round, the lap 2 pi R
+  // / v = 2 pi sqrt(R / 12): 7.025 s at R = 15, 6.545 s on the centreline
+  // (R = 13). The cones' polygons sit a few cm inside the circles.
+  const world::TrackModel track = ring();
+  const LimitLines l = limit_lines(track, flat_envelope(12.0, 5.0, 10.0), 1.0);
+  EXPECT_NEAR(l.min_curvature.lap_time, 2.0 * kPi * std::sqrt(15.0 / 12.0), 0.005 * 7.025);
+  EXPECT_NEAR(l.centreline.lap_time, 2.0 * kPi * std::sqrt(13.0 / 12.0), 0.005 * 6.545);
+  EXPECT_NEAR(l.min_curvature.v_min, std::sqrt(12.0 * 15.0), 0.05);
+  EXPECT_NEAR(l.min_curvature.v_max, std::sqrt(12.0 * 15.0), 0.05);
+  EXPECT_NEAR(l.min_curvature.clearance_min, 1.0, 0.05);
+  // a wider clearance, a smaller circle
+  const LimitLines tight = limit_lines(track, flat_envelope(12.0, 5.0, 10.0), 2.0);
+  EXPECT_NEAR(tight.min_curvature.lap_time, 2.0 * kPi * std::sqrt(14.0 / 12.0), 0.005 * 6.77);
+}
+
+TEST(LimitLines, NotACircuitIsAnError) {
+  const std::string acc = read_file(kRoot + "/tracks/acceleration.csv");
+  const world::TrackModel track = world::build_track(world::parse_track(acc, "acceleration.csv"));
+  try {
+    limit_lines(track, flat_envelope(12.0, 5.0, 10.0));
+    FAIL() << "no error";
+  } catch (const UserError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("only a circuit"));
+  }
+}
+
+TEST(LimitReport, FsgLinesRespectTheEnvelopeAndTheClearance) {
+  const Scenario s = load_scenario(kRoot + "/scenarios/fsg_2023_trackdrive.ini");
+  const world::TrackModel track = world::build_track(load_track_file(s.track_path));
+  const LimitReport r = limit_report(s.vehicle, track, "fsg_2023_trackdrive.ini");
+  const LimitLine& racing = r.lines.min_curvature;
+  // the racing line bends less and laps faster than the centreline
+  EXPECT_LT(r.lines.cost_min_curvature, 0.7 * r.lines.cost_centreline);
+  EXPECT_LT(racing.lap_time, 0.95 * r.lines.centreline.lap_time);
+  // it keeps the clearance (the optimised points and the half-way points do; the spline within 3 cm)
+  EXPECT_GE(racing.clearance_min, r.lines.clearance - 0.03);
+  // the car can steer it
+  EXPECT_LT(racing.curvature_max, r.steering_curvature);
+  // every sample within the envelope: the lateral limit, and the speed
+  // change over each step within what the envelope allows at its start
+  const auto& pts = racing.trajectory.points;
+  const std::size_t n = pts.size();
+  const double ds = racing.trajectory.length / static_cast<double>(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const TrajectoryPoint &a = pts[i], &b = pts[(i + 1) % n];
+    EXPECT_LE(a.speed * a.speed * std::abs(a.curvature), planning::planned_lateral_limit(a.speed, r.envelope) * (1 + 1e-9));
+    const double accel = (b.speed * b.speed - a.speed * a.speed) / (2.0 * ds);
+    if (accel > 0) EXPECT_LE(accel, planning::available_acceleration(a.speed, a.curvature, r.envelope) + 1e-6) << i;
+    else EXPECT_LE(-accel, planning::available_deceleration(b.speed, b.curvature, r.envelope) * 1.05 + 1e-6) << i;
+    EXPECT_LE(a.speed, r.ggv.top_speed + 1e-9);
+  }
+  // the envelope grows with speed (downforce) and loses acceleration to drag
+  EXPECT_GT(r.envelope.ggv_lateral.back(), r.envelope.ggv_lateral.front());
+  EXPECT_EQ(r.envelope.ggv_accel.back(), 0.0);
+}
+
+TEST(GgvEnvelope, NodesFromTheRowsAndTheGripLineUnderTheLock) {
+  // grip rows on ay = 16 + 0.005 v^2; a row bounded by the steering lock
+  // takes the line's value; nodes at rest and at the top speed
+  std::vector<GgvRow> rows;
+  for (double v : {5.0, 10.0, 15.0, 20.0}) {
+    GgvRow g;
+    g.speed = v;
+    g.lateral = v == 5.0 ? 9.0 : 16.0 + 0.005 * v * v;
+    g.lateral_limit = v == 5.0 ? "steering lock" : "grip";
+    g.acceleration = 14.0 - 0.2 * v;
+    g.braking = 15.0;
+    rows.push_back(g);
+  }
+  const planning::VelocityProfileParams e = ggv_envelope(rows, 27.0);
+  ASSERT_EQ(e.ggv_speed, (std::vector<double>{0.0, 5.0, 10.0, 15.0, 20.0, 27.0}));
+  EXPECT_NEAR(e.ggv_lateral[0], 16.0, 1e-9);
+  EXPECT_NEAR(e.ggv_lateral[1], 16.125, 1e-9);
+  EXPECT_NEAR(e.ggv_lateral[3], 16.0 + 0.005 * 225.0, 1e-9);
+  EXPECT_EQ(e.ggv_accel.front(), 13.0);
+  EXPECT_EQ(e.ggv_accel.back(), 0.0);
+  EXPECT_EQ(e.limits, planning::VelocityProfileParams::Ggv);
+  EXPECT_EQ(params::validate(e), "");
+  // the stack's lines read back to the same envelope
+  EXPECT_THAT(ggv_ini(e), HasSubstr("ggv_speed = 0.00, 5.00, 10.00, 15.00, 20.00, 27.00\n"));
+}
+
+using paddock::testing::Outcome;
+Outcome paddock(const std::string& args) { return paddock::testing::run_paddock(args); }
+
+TEST(ReportLimitCli, WritesItsFilesAndRejectsBadInput) {
+  const std::string out = scratch("fsg");
+  fs::remove_all(out);
+  Outcome o = paddock("report limit " + kRoot + "/scenarios/fsg_2023_trackdrive.ini --out " + out + " --map-size 400");
+  ASSERT_EQ(o.code, 0) << o.output;
+  EXPECT_THAT(o.output, HasSubstr("min_curvature"));
+  const auto j = nlohmann::json::parse(read_file(out + "/limit_report.json"));
+  EXPECT_GT(j["centreline"]["lap_time"].get<double>(), j["limit_lap_s"].get<double>());
+  EXPECT_TRUE(fs::exists(out + "/limit.png"));
+  EXPECT_THAT(read_file(out + "/limit_lines.csv"), HasSubstr("line,s,x,y,heading,curvature,speed\n"));
+
+  o = paddock("report limit " + kRoot + "/scenarios/skidpad.ini --out " + scratch("skid"));
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr("only a circuit"));
+  o = paddock("report limit " + kRoot + "/scenarios/fsg_2023_trackdrive.ini --clearance -1");
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr("--clearance: expected a distance >= 0 m"));
+  o = paddock("report limit");
+  EXPECT_EQ(o.code, 2);
+  EXPECT_THAT(o.output, HasSubstr("report limit needs a scenario file"));
+}
+
+}  // namespace
+}  // namespace paddock::runner
