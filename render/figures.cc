@@ -130,7 +130,7 @@ Figure draw_track_map(const TrackMapData& d, const FigureStyle& style) {
   if (has_speed) {
     cb.lo = sr.lo, cb.hi = sr.hi;
     widen(cb.lo, cb.hi);
-    cb.label = "speed [m/s]";
+    cb.label = d.speed_label;
   }
 
   // the legend: what is shown, in drawing order

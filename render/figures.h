@@ -103,6 +103,7 @@ struct TrackMapData {
                                              // over [min, max] ([v - 0.5, v + 0.5] for one speed v);
                                              // empty: one colour, no colour bar; NaN: a gap
   std::string trajectory_label = "trajectory";  // its legend entry
+  std::string speed_label = "speed [m/s]";      // the colour bar's label
   std::vector<MapLayer> layers;              // optional layers
   std::vector<Cone> estimated_cones;         // optional: a cone map estimated by SLAM (hollow markers)
 };

@@ -45,6 +45,64 @@ bool triangulate_and_search(const std::vector<Cone>& cone_map, const Pose2& vehi
   return true;
 }
 
+// the boundaries of a closed lap: every mapped cone within kBoundaryReach
+// of the lap's centreline, on the side of it where it lies, in the order of
+// its projection along the lap (the cones the lap passes: the nearest part
+// of the lap claims a cone, so a neighbouring leg's cones are not this one's)
+constexpr double kBoundaryReach = 3.5;  // m: half the widest FS track and a cone's offset
+
+void lap_boundaries(const std::vector<Vec2>& lap, const std::vector<Cone>& cones, const Triangulation& tri,
+                    std::vector<Vec2>& left, std::vector<Vec2>& right) {
+  std::vector<std::pair<double, Vec2>> l, r;
+  for (std::size_t i = 0; i < cones.size(); ++i) {
+    const Cone& c = cones[i];
+    // a doubled cone once (the triangulation merged it), a non-finite one never
+    if (i >= tri.representative.size() || tri.representative[i] != i) continue;
+    const Projection p = project(lap, true, c.position);
+    if (p.distance > kBoundaryReach) continue;
+    (p.signed_offset > 0.0 ? l : r).push_back({p.s, c.position});
+  }
+  const auto by_s = [](const auto& a, const auto& b) { return a.first < b.first; };
+  std::stable_sort(l.begin(), l.end(), by_s);
+  std::stable_sort(r.begin(), r.end(), by_s);
+  for (const auto& [s, q] : l) left.push_back(q);
+  for (const auto& [s, q] : r) right.push_back(q);
+}
+
+}  // namespace
+
+bool plan_racing_line(PlanResult& out, const std::vector<Cone>& cones, const PathPlannerParams& params) {
+  out.racing_line.clear();
+  out.left_boundary.clear();
+  out.right_boundary.clear();
+  out.racing_fallback.clear();
+  if (!out.ok() || !out.closed) {
+    out.racing_fallback = "racing line: not a planned lap";
+    return false;
+  }
+  lap_boundaries(out.smoothed, cones, out.triangulation, out.left_boundary, out.right_boundary);
+  const RacingLine line = min_curvature_line(out.smoothed, out.left_boundary, out.right_boundary, true, params.racing);
+  if (!line.ok()) {
+    out.racing_fallback = line.reason;
+    return false;
+  }
+  const SplineFit fit = fit_spline(line.points, true);
+  if (!fit.ok()) {
+    out.racing_fallback = "racing line: " + fit.reason;
+    return false;
+  }
+  ReferenceResult racing = reference_from_spline(fit.spline, params.reference);
+  if (!racing.ok()) {
+    out.racing_fallback = "racing line: " + racing.reason;
+    return false;
+  }
+  out.racing_line = line.points;
+  out.trajectory = std::move(racing.trajectory);
+  return true;
+}
+
+namespace {
+
 // the end every planner shares: the reference's trajectory and Ok, or
 // NoReference with the reference's reason
 PlanResult with_reference(PlanResult out, ReferenceResult ref) {
@@ -114,12 +172,18 @@ PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, do
   const std::optional<double> v_start =
       out.closed ? std::nullopt : std::optional<double>(std::max(0.0, speed));
   const std::optional<double> v_end = out.closed ? std::nullopt : std::optional<double>(0.0);
-  ReferenceResult ref = build_reference(out.smoothed, out.closed, params.reference, v_start, v_end);
+  // an open path explores: with the envelope, at its own margins
+  ReferenceParams reference = params.reference;
+  if (!out.closed && reference.profile.limits == VelocityProfileParams::Ggv) {
+    reference.profile.margin_lateral = params.explore_margin_lateral;
+    reference.profile.margin_longitudinal = params.explore_margin_longitudinal;
+  }
+  ReferenceResult ref = build_reference(out.smoothed, out.closed, reference, v_start, v_end);
   // the spline can swing back towards a cone between the points: push the
   // points near such samples further and fit again (a few rounds)
   for (int round = 0; round < 3 && ref.ok(); ++round) {
     if (clear_trajectory(out.smoothed, ref.trajectory, cone_map, params.clearance) == 0) break;
-    ref = build_reference(out.smoothed, out.closed, params.reference, v_start, v_end);
+    ref = build_reference(out.smoothed, out.closed, reference, v_start, v_end);
   }
   return with_reference(std::move(out), std::move(ref));
 }

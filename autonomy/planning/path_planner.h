@@ -16,23 +16,53 @@
 #include "autonomy/planning/centreline.h"
 #include "autonomy/planning/clearance.h"
 #include "autonomy/planning/delaunay.h"
+#include "autonomy/planning/racing_line.h"
 #include "autonomy/planning/reference.h"
 #include "autonomy/planning/smoothing.h"
 
 namespace paddock::planning {
 
 struct PathPlannerParams {
+  // the line a trackdrive's locked lap is driven on: the paper's smoothed
+  // centreline, or the minimum-curvature line inside the lap's mapped
+  // boundaries (plan_racing_line); open paths (exploring, autocross) always
+  // follow the centreline
+  enum Line { Centreline, MinCurvature };
+  static constexpr params::Choice<Line> kLineNames[] = {{"centreline", Centreline}, {"min_curvature", MinCurvature}};
+  Line line = Centreline;
   CentrelineParams search;
   SmoothingParams smoothing;
   ClearanceParams clearance;
   ReferenceParams reference;
+  // the racing line of a lap (line = min_curvature). Its clearance is to the
+  // boundary lines between the cones, the car's centre kept half its width
+  // (0.7 m) and a margin for tracking errors and the rear axle's
+  // off-tracking away; boundary segments longer than max_gap are not known
+  // well enough (a cone missed by the map), and the line keeps to the
+  // centreline across them
+  // limits = ggv: the shares of the envelope an open path (exploring: the
+  // autocross, a trackdrive's first lap) plans with in place of the
+  // profile's margins, lower because the map ahead is still being found and
+  // the path is replanned every cycle
+  double explore_margin_lateral = 0.6;
+  double explore_margin_longitudinal = 0.6;
+  RacingLineParams racing = [] {
+    RacingLineParams r;
+    r.clearance = 1.2;
+    r.max_gap = 8.0;
+    return r;
+  }();
 
   template <class V>
   void visit(V& v) {
+    v(PADDOCK_PARAM(line), kLineNames, "a full lap's line: the centreline, or the minimum-curvature racing line");
     v.section(PADDOCK_PARAM(search), "the reward-based centreline search");
     v.section(PADDOCK_PARAM(smoothing), "the centreline's smoothing");
     v.section(PADDOCK_PARAM(clearance), "the smoothed points are pushed clear of the cones");
     v.section(PADDOCK_PARAM(reference), "the reference trajectory: spline and velocity profile");
+    v(PADDOCK_PARAM(explore_margin_lateral), {"", params::above_up_to(0.0, 1.0), "limits = ggv: lateral share of the envelope on an open path"});
+    v(PADDOCK_PARAM(explore_margin_longitudinal), {"", params::above_up_to(0.0, 1.0), "limits = ggv: longitudinal share of the envelope on an open path"});
+    v.section(PADDOCK_PARAM(racing), "the minimum-curvature racing line of a full lap (line = min_curvature)");
   }
 };
 
@@ -53,6 +83,13 @@ struct PlanResult {
   bool closed = false;            // a full lap: closed spline and closed velocity profile
   Triangulation triangulation;    // for plots: the grey layer, the midpoints
   CentrelineResult search;        // the search's points, scores and stop reason
+  // a full lap with line = min_curvature: the racing line's optimised points
+  // (empty when the lap follows the centreline), its boundaries from the
+  // lap's cones, and why the centreline was kept (empty when
+  // the racing line is driven)
+  std::vector<Vec2> racing_line;
+  std::vector<Vec2> left_boundary, right_boundary;
+  std::string racing_fallback;
   PlanStatus status = PlanStatus::BadInput;
   std::string reason;             // empty when Ok
 
@@ -64,7 +101,8 @@ struct PlanResult {
 //   speed    its speed (m/s): an open trajectory starts at most this fast
 //            (negative counts as 0)
 // A full lap (the search closes the loop) gives a closed trajectory with a
-// closed velocity profile. Otherwise the path is open: it starts at the
+// closed velocity profile (along the centreline: plan_racing_line turns it
+// into the racing line). Otherwise the path is open: it starts at the
 // vehicle and ends at the last centreline point found, at speed 0, since the
 // car must be able to stop before the unknown. With `lap` false a lap is not
 // wanted yet (a car that has not driven far enough for the search's lap to be
@@ -82,6 +120,16 @@ PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, do
 PlanResult plan_acceleration(const std::vector<Cone>& cone_map, const Pose2& vehicle,
                              double speed, const PathPlannerParams& params = {},
                              std::optional<double> length = std::nullopt);
+
+// the racing line of a planned lap (plan_path's closed result): the
+// minimum-curvature line (params.racing) inside the lap's boundaries, which
+// are the mapped cones within 3.5 m of the lap's smoothed centreline, on the
+// side where each lies, in the order of their projections along it; its
+// trajectory replaces the lap's, with params.reference's profile. False,
+// with the lap left as it was and racing_fallback saying why, when it fails
+// or `lap` is not a planned closed lap. Meant for a lap that is final (the
+// trackdrive's locked lap): it takes tens of milliseconds.
+bool plan_racing_line(PlanResult& lap, const std::vector<Cone>& cones, const PathPlannerParams& params = {});
 
 const char* to_string(PlanStatus s);
 

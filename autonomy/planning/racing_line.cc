@@ -28,13 +28,14 @@ bool all_finite(const std::vector<Vec2>& pts) {
 
 // the distance along the ray o + t d (t > 0, d a unit vector) to the first
 // crossing of the polyline, infinite when it crosses none
-double ray_distance(Vec2 o, Vec2 d, const std::vector<Vec2>& line, bool closed) {
+double ray_distance(Vec2 o, Vec2 d, const std::vector<Vec2>& line, bool closed, double max_gap) {
   double best = kInf;
   const std::size_t n = line.size();
   const std::size_t segments = closed ? n : (n > 0 ? n - 1 : 0);
   for (std::size_t i = 0; i < segments; ++i) {
     const Vec2 a = line[i], b = line[(i + 1) % n];
     const Vec2 e = b - a;
+    if (squared_norm(e) > max_gap * max_gap) continue;  // a gap, not a boundary
     const double den = cross(d, e);
     if (std::abs(den) < 1e-12) continue;  // parallel
     const Vec2 w = a - o;
@@ -270,8 +271,8 @@ RacingLine min_curvature_line(const std::vector<Vec2>& reference, const std::vec
       return out;
     }
     normal[i] = left_normal((1.0 / len) * t);
-    double dl = ray_distance(r[i], normal[i], left, closed);
-    double dr = ray_distance(r[i], -1.0 * normal[i], right, closed);
+    double dl = ray_distance(r[i], normal[i], left, closed, params.max_gap);
+    double dr = ray_distance(r[i], -1.0 * normal[i], right, closed, params.max_gap);
     // no boundary within reach: the point may not move to that side
     if (!(dl <= params.reach)) dl = params.clearance;
     if (!(dr <= params.reach)) dr = params.clearance;

@@ -44,6 +44,9 @@ struct RacingLineParams {
   // point may not leave the reference on that side
   double reach = 15.0;
   int max_iterations = 300;
+  // a boundary segment longer than this (m) is not a boundary: two cones
+  // that far apart leave a gap the line must not be drawn into
+  double max_gap = 1e9;
 
   template <class V>
   void visit(V& v) {
@@ -51,6 +54,7 @@ struct RacingLineParams {
     v(PADDOCK_PARAM(step), {"m", params::in(0.1, 10.0), "spacing of the optimised points"});
     v(PADDOCK_PARAM(reach), {"m", params::above(0.0), "a boundary further than this along a normal is not used"});
     v(PADDOCK_PARAM(max_iterations), {"", params::in(1, 10000), "solver iterations at most"});
+    v(PADDOCK_PARAM(max_gap), {"m", params::above(0.0), "boundary segments longer than this are gaps, not boundaries"});
   }
 };
 

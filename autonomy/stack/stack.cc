@@ -230,6 +230,12 @@ void Stack::plan(const hal::StateEstimate& st) {
     const bool back_at_start =
         start_position_ && distance(st.pose.position(), *start_position_) < mp.loop_closure_radius;
     if (back_at_start || mp.loop_closure_radius <= 0.0) {
+      // the lap to drive from now on: its racing line when asked for (the
+      // centreline when that fails, and the fault says why)
+      if (spec_.mission == Mission::Trackdrive && params_.planning.line == planning::PathPlannerParams::MinCurvature &&
+          !planning::plan_racing_line(res, cones, params_.planning)) {
+        telemetry_.last_fault = "planning: " + res.racing_fallback;
+      }
       pending_lap_ = res.trajectory;
       telemetry_.lap_locked = spec_.mission == Mission::Trackdrive;
     } else {
@@ -243,6 +249,27 @@ void Stack::plan(const hal::StateEstimate& st) {
   last_plan_ = std::move(res);
   last_plan_cones_ = cones;
   if (spec_.gates.empty()) learn_gates(st.pose, st.stamp, st.vx);
+}
+
+double Stack::finish_approach_cap(Vec2 base) const {
+  const MissionParams& mp = params_.mission;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  if (spec_.finish_crossings <= 0 || telemetry_.finish_crossings != spec_.finish_crossings - 1 || trajectory_.empty())
+    return kInf;
+  // braking at stop_decel_max to the finish speed that stops in stop_distance
+  const double a = mp.stop_decel_max;
+  const double v_finish2 = 2.0 * a * mp.stop_distance;
+  const TrajectoryProjection car = project(trajectory_, base, 0.0, 0.0);
+  double cap = kInf;
+  for (const Segment& g : gates_) {
+    const TrajectoryProjection gate = project(trajectory_, 0.5 * (g.a + g.b), 0.0, 0.0);
+    if (std::abs(gate.offset) > mp.gate_max_offset) continue;  // not a gate on this path
+    double ahead = gate.s - car.s;
+    if (trajectory_.closed && ahead < 0.0) ahead += trajectory_.length;
+    if (ahead < 0.0) continue;
+    cap = std::min(cap, std::sqrt(v_finish2 + 2.0 * a * ahead));
+  }
+  return cap;
 }
 
 void Stack::start_stopping(TimeNs now, double speed) {
@@ -372,10 +399,16 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   // mission progress: gate crossings of the base origin
   count_crossings(st.pose.position(), now, st.vx);
 
-  // after the finish the speed cap ramps down at the stop deceleration
+  // after the finish the speed cap ramps down to rest within the stop
+  // distance; before the last finish it caps the approach
+  const MissionParams& mp = params_.mission;
   double max_speed = std::numeric_limits<double>::infinity();
   if (telemetry_.stopping) {
-    max_speed = std::max(0.0, stop_speed_ - params_.mission.stop_decel * to_seconds(now - stop_start_));
+    const double decel = std::clamp(stop_speed_ * stop_speed_ / (2.0 * mp.stop_distance), mp.stop_decel,
+                                    std::max(mp.stop_decel, mp.stop_decel_max));
+    max_speed = std::max(0.0, stop_speed_ - decel * to_seconds(now - stop_start_));
+  } else {
+    max_speed = finish_approach_cap(st.pose.position());
   }
 
   control::ControlInput in;
@@ -401,7 +434,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   if (spec_.finish_crossings == 0 && !trajectory_.closed && out.diagnostics.s >= trajectory_.length - end_margin) {
     start_stopping(now, st.vx);
   }
-  if (telemetry_.stopping && speed < params_.mission.standstill_speed) as = hal::AsState::Finished;
+  if (telemetry_.stopping && speed < mp.standstill_speed) as = hal::AsState::Finished;
 
   cmd.as_state = as;
   if (as == hal::AsState::Finished) {

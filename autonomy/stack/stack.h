@@ -58,8 +58,15 @@ struct AutonomyModes {
 enum class Mission { Acceleration, Skidpad, Autocross, Trackdrive };
 
 struct MissionParams {
-  // the planner's braking limit
+  // the stop after the finish: the speed cap ramps down at
+  // v_finish^2 / (2 stop_distance), at least stop_decel and at most
+  // stop_decel_max; on the last lap the car approaches the finish no faster
+  // than it can stop from in stop_distance at stop_decel_max (braking to it
+  // at stop_decel_max). The rules allow 30 m; the rest of them is for the
+  // speed loop's lag and the braking's build-up.
   double stop_decel = 8.0;
+  double stop_distance = 20.0;
+  double stop_decel_max = 12.0;
   double standstill_speed = 0.05;
   double state_timeout = 0.2;
   // a car at rest needs a reference above zero to start on
@@ -89,7 +96,9 @@ struct MissionParams {
 
   template <class V>
   void visit(V& v) {
-    v(PADDOCK_PARAM(stop_decel), {"m/s^2", params::in(0.1, 50.0), "deceleration of the stop after the finish"});
+    v(PADDOCK_PARAM(stop_decel), {"m/s^2", params::in(0.1, 50.0), "least deceleration of the stop after the finish"});
+    v(PADDOCK_PARAM(stop_distance), {"m", params::in(1.0, 1000.0), "the stop after the finish is planned to end within this"});
+    v(PADDOCK_PARAM(stop_decel_max), {"m/s^2", params::in(0.1, 50.0), "hardest planned stop, and the approach to the finish on the last lap"});
     v(PADDOCK_PARAM(standstill_speed), {"m/s", params::in(0.0, 5.0), "below this the stack counts as stopped"});
     v(PADDOCK_PARAM(state_timeout), {"s", params::in(0.001, 10.0), "a staler state estimate triggers the safe stop"});
     v(PADDOCK_PARAM(launch_speed), {"m/s", params::at_least(0.0), "the least start speed of a planned profile"});
@@ -217,6 +226,9 @@ class Stack {
   // planner = delaunay: a new plan from the cone map when the map has news
   void plan(const hal::StateEstimate& st);
   void learn_gates(const Pose2& pose, TimeNs now, double speed);
+  // on the last lap: the fastest speed from which the car can still brake to
+  // the finish speed that stops within the stop distance (infinite otherwise)
+  double finish_approach_cap(Vec2 base) const;
   void count_crossings(Vec2 base, TimeNs now, double speed);
   // counts a crossing made at driven distance `at` (m) unless it is within the
   // refractory distance of the last one; true when counted

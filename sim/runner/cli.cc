@@ -156,6 +156,7 @@ int cmd_run(const std::vector<std::string>& args) {
   write_file_atomic(out_dir + "/scenario.ini", resolved_ini(scenario));
   write_file_atomic(out_dir + "/log.csv", log_csv(result.log));
   write_file_atomic(out_dir + "/plan.json", plan_json(result));
+  if (result.limit) write_file_atomic(out_dir + "/limit_lines.csv", limit_lines_csv(*result.limit));
   if (scenario.autonomy.slam != stack::SlamMode::GroundTruth) {
     write_file_atomic(out_dir + "/slam.csv", slam_csv(result.slam.series));
   } else {

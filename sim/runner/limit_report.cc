@@ -12,6 +12,7 @@
 #include "autonomy/planning/reference.h"
 #include "autonomy/planning/spline.h"
 #include "sim/runner/files.h"
+#include "sim/runner/plots.h"
 
 namespace paddock::runner {
 

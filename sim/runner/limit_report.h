@@ -13,11 +13,12 @@
 
 #include "autonomy/common/trajectory.h"
 #include "autonomy/planning/velocity_profile.h"
-#include "sim/runner/plots.h"
 #include "sim/runner/vehicle_report.h"
 #include "sim/world/track.h"
 
 namespace paddock::runner {
+
+struct PlotOptions;  // plots.h
 
 // the clearance of the and the report's reference line (m)
 inline constexpr double kLimitClearance = 1.0;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "render/figures.h"
@@ -291,6 +292,82 @@ std::vector<std::string> plot_slam(const std::string& dir, const render::TrackMa
   write_png(paths[1], render::draw_line_chart(chart, chart_style).image);
   return paths;
 }
+// one sample of DIR/limit_lines.csv's minimum-curvature line
+struct LimitSample {
+  Vec2 position;
+  double speed = 0.0;
+};
+
+// the minimum-curvature line of DIR/limit_lines.csv (limit_lines_csv)
+std::vector<LimitSample> read_limit_line(const std::string& path) {
+  std::istringstream in(read_file(path));
+  std::string line;
+  int number = 0;
+  std::vector<LimitSample> out;
+  while (std::getline(in, line)) {
+    ++number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (number == 1) {
+      if (line != "line,s,x,y,heading,curvature,speed")
+        throw UserError(path + ":1: expected the header 'line,s,x,y,heading,curvature,speed'");
+      continue;
+    }
+    if (line.empty()) continue;
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    for (std::string item; std::getline(ss, item, ',');) f.push_back(item);
+    double v[6];
+    bool ok = f.size() == 7;
+    for (std::size_t k = 1; ok && k < 7; ++k) {
+      char* end = nullptr;
+      v[k - 1] = std::strtod(f[k].c_str(), &end);
+      ok = end != f[k].c_str() && *end == '\0' && std::isfinite(v[k - 1]);
+    }
+    if (!ok) throw UserError(path + ":" + std::to_string(number) + ": expected a line name and 6 finite numbers");
+    if (f[0] == "min_curvature") out.push_back({{v[1], v[2]}, v[5]});
+  }
+  return out;
+}
+
+// DIR/limit.png: the best lap driven over the car's minimum-curvature line,
+// coloured by how much slower than the line's QSS speed it went
+std::vector<std::string> plot_limit(const std::string& dir, const render::TrackMapData& track_map,
+                                    const std::vector<LogRow>& log, const SummaryLaps& laps,
+                                    const render::FigureStyle& map_style) {
+  const std::string path = dir + "/limit_lines.csv";
+  if (!std::filesystem::exists(path) || laps.time.empty()) return {};
+  const std::vector<LimitSample> line = read_limit_line(path);
+  if (line.size() < 2) return {};
+  // the best lap (a flying one when there are several)
+  std::size_t best = laps.time.size() > 1 ? 1 : 0;
+  for (std::size_t i = best; i < laps.time.size(); ++i)
+    if (laps.time[i] < laps.time[best]) best = i;
+  const double t0 = laps.start[best], t1 = t0 + laps.time[best];
+  render::TrackMapData map = track_map;
+  map.title = track_map.title.substr(0, track_map.title.find(':')) + ": lap " + std::to_string(best + 1) + " against the limit";
+  map.layers.clear();
+  map.estimated_cones.clear();
+  map.trajectory.clear();
+  map.speed.clear();
+  render::MapLayer racing{render::MapLayer::Kind::Polyline, "minimum-curvature line", {150, 150, 150, 255}, 1.0, render::Marker::Circle, {}, true};
+  for (const LimitSample& s : line) racing.points.push_back(s.position);
+  map.layers.push_back(std::move(racing));
+  for (const LogRow& r : log) {
+    if (r.t < t0 || r.t > t1) continue;
+    const Vec2 p{r.x, r.y};
+    std::size_t near = 0;
+    for (std::size_t k = 1; k < line.size(); ++k)
+      if (squared_norm(line[k].position - p) < squared_norm(line[near].position - p)) near = k;
+    map.trajectory.push_back(p);
+    map.speed.push_back(line[near].speed - std::hypot(r.vx, r.vy));
+  }
+  map.trajectory_label = "lap " + std::to_string(best + 1) + " driven";
+  map.speed_label = "QSS limit speed - driven speed [m/s]";
+  const std::string out = dir + "/limit.png";
+  write_png(out, render::draw_track_map(map, map_style).image);
+  return {out};
+}
+
 }  // namespace
 
 std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) {
@@ -375,6 +452,7 @@ std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) 
   write_png(paths[2], render::draw_lap_chart(chart, chart_style).image);
   for (const std::string& p : plot_perception(dir, map_style, chart_style)) paths.push_back(p);
   for (const std::string& p : plot_slam(dir, map, map_style, chart_style)) paths.push_back(p);
+  for (const std::string& p : plot_limit(dir, map, log, laps, map_style)) paths.push_back(p);
   return paths;
 }
 

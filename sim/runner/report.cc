@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -52,6 +53,16 @@ std::vector<std::string> check_expectations(const Expectations& e, const RunResu
   if (e.map_recall_min && r.slam.map.recall < *e.map_recall_min) {
     failed.push_back("map recall: expected at least " + fixed(*e.map_recall_min, 3) + ", got " + fixed(r.slam.map.recall, 3));
   }
+  if (e.best_above_limit_max) {
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& lap : ev.laps) best = std::min(best, lap.time);
+    if (!r.limit_lap) {
+      failed.push_back("best lap above the limit: the track has no limit lap (not a circuit)");
+    } else if (!(best / *r.limit_lap - 1.0 <= *e.best_above_limit_max)) {
+      failed.push_back("best lap above the limit: expected at most " + fixed(100.0 * *e.best_above_limit_max, 1) + " %, got " +
+                       (ev.laps.empty() ? std::string("no lap") : fixed(100.0 * (best / *r.limit_lap - 1.0), 1) + " %"));
+    }
+  }
   if (e.fallbacks_max && r.fallbacks > *e.fallbacks_max) {
     failed.push_back("fallbacks: expected at most " + std::to_string(*e.fallbacks_max) + ", got " + std::to_string(r.fallbacks));
   }
@@ -64,14 +75,23 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
   const events::Rules rules = events::rules_for(s.scenario.event);
   o << s.name << ": " << events::to_string(s.scenario.event) << " on " << s.track_path << "\n";
   o << "  result      " << (ev.finished ? "finished" : "DNF: " + ev.dnf_reason) << "\n";
-  o << "  lap     time [s]   DOO  OC   rms [m]  max [m]  ITAE   energy [Wh]\n";
+  o << "  lap     time [s]   DOO  OC   rms [m]  max [m]  ITAE   energy [Wh]" << (r.limit_lap ? "  above limit" : "") << "\n";
   for (std::size_t i = 0; i < ev.laps.size(); ++i) {
     const auto& lap = ev.laps[i];
     const auto& tr = r.lap_tracking[i];
-    char buf[160];
-    std::snprintf(buf, sizeof buf, "  %3d%s %9.3f   %3d %3d   %7.3f  %7.3f  %7.1f  %8.1f\n", lap.number,
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "  %3d%s %9.3f   %3d %3d   %7.3f  %7.3f  %7.1f  %8.1f", lap.number,
                   lap.timed ? " " : "*", lap.time, lap.doo, lap.oc, tr.rms, tr.max, tr.itae, lap.energy / 3600.0);
     o << buf;
+    if (r.limit_lap) {
+      std::snprintf(buf, sizeof buf, "  %+10.1f %%", 100.0 * (lap.time / *r.limit_lap - 1.0));
+      o << buf;
+    }
+    o << "\n";
+  }
+  if (r.limit_lap) {
+    o << "  limit       " << fixed(*r.limit_lap, 3)
+      << " s: the car's QSS flying lap on the minimum-curvature line 1 m from the boundaries (paddock report limit)\n";
   }
   if (!rules.timed_laps.empty()) o << "  (* untimed lap)\n";
   o << "  penalties   DOO " << ev.doo << " x " << fixed(rules.doo_penalty, 1) << " s, OC " << ev.oc << " x "
@@ -179,7 +199,8 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
     const auto& tr = r.lap_tracking[i];
     laps.push_back({{"lap", lap.number}, {"start", lap.start}, {"time", lap.time}, {"timed", lap.timed},
                     {"doo", lap.doo}, {"oc", lap.oc}, {"tracking", tracking(tr.rms, tr.max, tr.itae)},
-                    {"energy", lap.energy}});
+                    {"energy", lap.energy},
+                    {"above_limit", r.limit_lap ? Json(lap.time / *r.limit_lap - 1.0) : Json(nullptr)}});
   }
   Json cones = Json::array();
   for (const ConeHit& c : r.cones_hit) {
@@ -216,6 +237,7 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"seed", s.scenario.seed},
       {"finished", ev.finished},
       {"dnf_reason", ev.dnf_reason},
+      {"limit_lap_s", r.limit_lap ? Json(*r.limit_lap) : Json(nullptr)},
       {"laps", laps},
       {"penalties", {{"doo", ev.doo}, {"oc", ev.oc}, {"uss", ev.uss}, {"seconds", penalty_s}, {"cones", cones}}},
       {"raw_time", ev.raw_time},

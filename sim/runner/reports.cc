@@ -77,6 +77,10 @@ std::string report_smoothing(const std::string& track_path) {
   if (!track.closed) throw UserError(track_path + ": the smoothing report needs a circuit (a closed track)");
   planning::PathPlannerParams params;
   params.clearance.clearance = 0.0;  // the smoothing alone, as the paper compares it
+  // the paper's planned limits: constant, 0.8 g, 20 m/s at most (the
+  // stack's default plans with the car's envelope instead)
+  params.reference.profile.limits = planning::VelocityProfileParams::Constant;
+  params.reference.profile.v_max = 20.0;
   // the full lap's raw centreline: the search on the ground-truth cones from the start pose
   const planning::PlanResult lap = planning::plan_path(track.cones, track.start, 0.0, params);
   if (!lap.ok() || !lap.closed) {

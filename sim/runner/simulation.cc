@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <future>
 #include <cmath>
 #include <cstdio>
 
@@ -218,6 +219,18 @@ void step(const SimModel& model, SimState& s) {
 
 RunResult run(const Scenario& scenario, const world::TrackModel& track) {
   const auto wall0 = std::chrono::steady_clock::now();
+  // the limit lap, on a second thread while the run goes on: it reads only
+  // the vehicle's parameters and the track
+  std::future<std::optional<LimitLines>> limit;
+  if (track.kind == world::TrackKind::Circuit && track.closed) {
+    limit = std::async(std::launch::async, [&scenario, &track]() -> std::optional<LimitLines> {
+      try {
+        return limit_lines(track, car_envelope(scenario.vehicle));
+      } catch (const std::exception&) {
+        return std::nullopt;
+      }
+    });
+  }
   const SimModel model = compile_model(scenario, track);
   SimState state(model);
   LogRecorder log;
@@ -238,6 +251,8 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track) {
   result.perception = scorer.metrics();
   result.slam = slam.metrics(model, state, result.event.laps);
   result.snapshot = std::move(snapshot.snapshot());
+  if (limit.valid()) result.limit = limit.get();
+  if (result.limit) result.limit_lap = result.limit->min_curvature.lap_time;
   result.wall_time = seconds_since(wall0);
   return result;
 }

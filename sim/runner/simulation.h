@@ -20,6 +20,7 @@
 
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
+#include "sim/runner/limit_report.h"
 #include "sim/runner/model.h"
 #include "sim/runner/observers.h"
 #include "sim/runner/perception_metrics.h"
@@ -120,6 +121,12 @@ struct RunResult {
   PerceptionMetrics perception;  // the stack's perceived cones against the truth, per range bin
   SlamMetrics slam;              // the stack's state estimate against the truth
   std::optional<PerceptionSnapshot> snapshot;
+  // the car's limit on a circuit: `paddock report limit`'s lines and its
+  // limit lap (the QSS on the minimum-curvature line 1 m from the
+  // boundaries, s), computed beside the run; nothing for other tracks, or
+  // when they cannot be built
+  std::optional<LimitLines> limit;
+  std::optional<double> limit_lap;
 };
 
 // runs one scenario to its end (finish or DNF); deterministic for a given

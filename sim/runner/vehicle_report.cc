@@ -10,6 +10,7 @@
 #include "autonomy/common/format.h"
 #include "render/colormap.h"
 #include "sim/runner/files.h"
+#include "sim/runner/plots.h"
 
 namespace paddock::runner {
 namespace {

@@ -10,10 +10,11 @@
 
 #include "autonomy/planning/velocity_profile.h"
 #include "render/figures.h"
-#include "sim/runner/plots.h"
 #include "sim/vehicle/vehicle.h"
 
 namespace paddock::runner {
+
+struct PlotOptions;  // plots.h
 
 // the FS acceleration event's length, m
 inline constexpr double kAccelerationLength = 75.0;

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 
 #include "sim/runner/files.h"
@@ -167,6 +168,21 @@ TEST(Cli, JsonSummaryCarriesTheSchema) {
     EXPECT_THAT(o.output, HasSubstr(key));
   }
   EXPECT_EQ(o.output.front(), '{');
+  // the car's limit lap on this circuit, and every lap above it (no lap can
+  // beat the car's own quasi-steady-state limit; a standing lap least of all)
+  const auto j = nlohmann::json::parse(o.output);
+  ASSERT_TRUE(j["limit_lap_s"].is_number()) << j["limit_lap_s"];
+  const double limit = j["limit_lap_s"].get<double>();
+  EXPECT_GT(limit, 5.0);
+  ASSERT_FALSE(j["laps"].empty());
+  for (const auto& lap : j["laps"]) {
+    EXPECT_NEAR(lap["above_limit"].get<double>(), lap["time"].get<double>() / limit - 1.0, 1e-12);
+    EXPECT_GT(lap["above_limit"].get<double>(), 0.0);
+  }
+  // a track without a lap has no limit
+  const auto acc = paddock("run " + kRoot + "/scenarios/acceleration.ini --json --out " + scratch("json_acc"));
+  ASSERT_EQ(acc.code, 0) << acc.output;
+  EXPECT_TRUE(nlohmann::json::parse(acc.output)["limit_lap_s"].is_null());
 }
 
 TEST(Cli, FailedExpectationsExitWith3AndSayWhich) {

@@ -52,6 +52,9 @@ TEST(Plots, RunWithPlotsDrawsTheThreeFiguresAtTheDefaultSizes) {
   const render::Image laps = png_at(dir + "/laps.png");
   EXPECT_EQ(laps.width, 1600);
   EXPECT_EQ(laps.height, 1200);
+  // a circuit: the run wrote the car's limit lines, and the best lap is drawn over them
+  EXPECT_THAT(read_file(dir + "/limit_lines.csv"), HasSubstr("\nmin_curvature,"));
+  EXPECT_EQ(png_at(dir + "/limit.png").width, 1600);
   // a figure is a picture, not a blank page: many pixels differ from the corner
   int drawn = 0;
   const render::Rgba bg = map.pixel(0, 0);
