@@ -101,6 +101,14 @@ bool plan_racing_line(PlanResult& out, const std::vector<Cone>& cones, const Pat
   return true;
 }
 
+bool plan_locked_lap(PlanResult& lap, const std::vector<Cone>& cones, const PathPlannerParams& params) {
+  if (params.line == PathPlannerParams::MinCurvature && plan_racing_line(lap, cones, params)) return true;
+  if (!lap.ok() || !lap.closed) return false;
+  ReferenceResult ref = build_reference(lap.smoothed, true, params.reference);
+  if (ref.ok()) lap.trajectory = std::move(ref.trajectory);
+  return params.line == PathPlannerParams::Centreline && ref.ok();
+}
+
 namespace {
 
 // the end every planner shares: the reference's trajectory and Ok, or
@@ -172,9 +180,9 @@ PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, do
   const std::optional<double> v_start =
       out.closed ? std::nullopt : std::optional<double>(std::max(0.0, speed));
   const std::optional<double> v_end = out.closed ? std::nullopt : std::optional<double>(0.0);
-  // an open path explores: with the envelope, at its own margins
+  // every path planned here explores: with the envelope, at its own margins
   ReferenceParams reference = params.reference;
-  if (!out.closed && reference.profile.limits == VelocityProfileParams::Ggv) {
+  if (reference.profile.limits == VelocityProfileParams::Ggv) {
     reference.profile.margin_lateral = params.explore_margin_lateral;
     reference.profile.margin_longitudinal = params.explore_margin_longitudinal;
   }

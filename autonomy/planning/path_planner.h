@@ -23,10 +23,10 @@
 namespace paddock::planning {
 
 struct PathPlannerParams {
-  // the line a trackdrive's locked lap is driven on: the paper's smoothed
-  // centreline, or the minimum-curvature line inside the lap's mapped
-  // boundaries (plan_racing_line); open paths (exploring, autocross) always
-  // follow the centreline
+  // the line a trackdrive's locked lap is driven on (plan_locked_lap): the
+  // paper's smoothed centreline, or the minimum-curvature line inside the
+  // lap's mapped boundaries (plan_racing_line); every path plan_path gives
+  // (exploring: autocross, a trackdrive's first lap) follows the centreline
   enum Line { Centreline, MinCurvature };
   static constexpr params::Choice<Line> kLineNames[] = {{"centreline", Centreline}, {"min_curvature", MinCurvature}};
   Line line = Centreline;
@@ -40,10 +40,12 @@ struct PathPlannerParams {
   // off-tracking away; boundary segments longer than max_gap are not known
   // well enough (a cone missed by the map), and the line keeps to the
   // centreline across them
-  // limits = ggv: the shares of the envelope an open path (exploring: the
-  // autocross, a trackdrive's first lap) plans with in place of the
+  // limits = ggv: the shares of the envelope every path plan_path gives
+  // (exploring: the autocross, a trackdrive's first lap, a lap the search
+  // closes before the car is back at its start) plans with in place of the
   // profile's margins, lower because the map ahead is still being found and
-  // the path is replanned every cycle
+  // the path is replanned every cycle; the profile's own margins are for
+  // the locked lap (plan_locked_lap)
   double explore_margin_lateral = 0.6;
   double explore_margin_longitudinal = 0.6;
   RacingLineParams racing = [] {
@@ -130,6 +132,14 @@ PlanResult plan_acceleration(const std::vector<Cone>& cone_map, const Pose2& veh
 // or `lap` is not a planned closed lap. Meant for a lap that is final (the
 // trackdrive's locked lap): it takes tens of milliseconds.
 bool plan_racing_line(PlanResult& lap, const std::vector<Cone>& cones, const PathPlannerParams& params = {});
+
+// the lap a trackdrive drives from its second lap on, from plan_path's
+// closed result: the racing line (line = min_curvature), or the centreline
+// (its spline again, with params.reference's profile: with limits = ggv the
+// lap's margins rather than plan_path's exploring ones). False when the
+// racing line failed (the centreline is then planned, and racing_fallback
+// says why) or `lap` is not a planned closed lap.
+bool plan_locked_lap(PlanResult& lap, const std::vector<Cone>& cones, const PathPlannerParams& params = {});
 
 const char* to_string(PlanStatus s);
 

@@ -232,9 +232,8 @@ void Stack::plan(const hal::StateEstimate& st) {
     if (back_at_start || mp.loop_closure_radius <= 0.0) {
       // the lap to drive from now on: its racing line when asked for (the
       // centreline when that fails, and the fault says why)
-      if (spec_.mission == Mission::Trackdrive && params_.planning.line == planning::PathPlannerParams::MinCurvature &&
-          !planning::plan_racing_line(res, cones, params_.planning)) {
-        telemetry_.last_fault = "planning: " + res.racing_fallback;
+      if (spec_.mission == Mission::Trackdrive && !planning::plan_locked_lap(res, cones, params_.planning)) {
+        telemetry_.last_fault = "planning: " + (res.racing_fallback.empty() ? "the locked lap kept its exploring profile" : res.racing_fallback);
       }
       pending_lap_ = res.trajectory;
       telemetry_.lap_locked = spec_.mission == Mission::Trackdrive;
@@ -389,7 +388,9 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   // the closed lap takes over where the car is on it
   if (!pending_lap_.empty()) {
     const Vec2 front = st.pose.transform({params_.vehicle.wheelbase, 0.0});
-    if (std::abs(project(pending_lap_, front, 0.0, 0.0).offset) < params_.mission.lap_switch_offset) {
+    const TrajectoryProjection on = project(pending_lap_, front, 0.0, 0.0);
+    if (std::abs(on.offset) < params_.mission.lap_switch_offset &&
+        std::abs(wrap_angle(on.ref.heading - st.pose.yaw)) < params_.mission.lap_switch_heading) {
       trajectory_ = std::move(pending_lap_);
       pending_lap_ = Trajectory{};
     }

@@ -80,6 +80,10 @@ struct MissionParams {
   double loop_closure_radius = 15.0;
   // so the handover does not jerk the car sideways
   double lap_switch_offset = 0.1;
+  // ... and heads within this of the car's heading: a racing line crosses
+  // the exploring path at an angle, and taking it over there at speed
+  // swings the car across it
+  double lap_switch_heading = 0.1;
   // a timekeeping gate is learned from big orange cones seen at least
   // gate_min_observations times whose gate's middle lies within
   // gate_max_offset of the planned path: a ghost cone of perception must not
@@ -106,6 +110,7 @@ struct MissionParams {
     v(PADDOCK_PARAM(loop_closure_radius), {"m", params::in(0.0, 10000.0),
                                            "the car must be this close to its start for the lap to be taken (0: anywhere)"});
     v(PADDOCK_PARAM(lap_switch_offset), {"m", params::in(0.0, 10.0), "the closed lap takes over where the car is this close to it"});
+    v(PADDOCK_PARAM(lap_switch_heading), {"rad", params::in(0.0, 3.2), "... and where it heads within this of the car's heading"});
     v(PADDOCK_PARAM(gate_min_observations), {"", params::at_least(1), "a timekeeping gate is learned from big orange cones seen this often ..."});
     v(PADDOCK_PARAM(gate_max_offset), {"m", params::at_least(0.0), "... whose gate's middle lies this close to the planned path"});
     v(PADDOCK_PARAM(gate_refractory_distance), {"m", params::at_least(0.0), "gate crossings closer together than this count once"});
