@@ -26,10 +26,6 @@ double interpolate(const std::vector<double>& xs, const std::vector<double>& ys,
 
 bool ggv(const VelocityProfileParams& p) { return p.limits == VelocityProfileParams::Ggv; }
 
-// the lateral limit at speed v (m/s^2)
-double lateral_limit(double v, const VelocityProfileParams& p) {
-  return ggv(p) ? p.margin_lateral * interpolate(p.ggv_speed, p.ggv_lateral, v) : p.ay_max;
-}
 
 // the longitudinal tyre limit left over by the lateral acceleration: the g-g
 // shape (ax/ax_lim)^p + (ay/ay_lim)^p = 1 solved for ax, zero once the turn
@@ -37,7 +33,7 @@ double lateral_limit(double v, const VelocityProfileParams& p) {
 // the lateral use (see the parameter's comment)
 double tyre_longitudinal(double ax_lim, double v, double kappa, const VelocityProfileParams& p) {
   // the share of the lateral limit a speed uses on a curvature, in [0, inf)
-  const double use = v * v * std::abs(kappa) / lateral_limit(v, p);
+  const double use = v * v * std::abs(kappa) / planned_lateral_limit(v, p);
   const double f = 1.0 - (1.0 - p.turn_accel_scale) * std::min(1.0, use);
   // the ellipse (p = 2) and the diamond (p = 1) without pow(), the common cases
   const bool ellipse = p.exponent == 2.0, diamond = p.exponent == 1.0;
@@ -128,7 +124,9 @@ double available_deceleration(double v, double kappa, const VelocityProfileParam
   return tyre_longitudinal(p.ax_brake_max, v, kappa, p) + drag_decel(v, p);
 }
 
-double planned_lateral_limit(double v, const VelocityProfileParams& p) { return lateral_limit(v, p); }
+double planned_lateral_limit(double v, const VelocityProfileParams& p) {
+  return ggv(p) ? p.margin_lateral * interpolate(p.ggv_speed, p.ggv_lateral, v) : p.ay_max;
+}
 
 std::string VelocityProfileParams::check() const {
   if (!(std::isfinite(mass) && mass > 0.0)) return "mass must be > 0 kg (got " + params::number(mass) + ")";

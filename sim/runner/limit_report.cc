@@ -167,12 +167,8 @@ std::string limit_lines_csv(const LimitLines& lines) {
 
 std::vector<std::string> write_limit_report(const LimitReport& r, const world::TrackModel& track, const std::string& dir,
                                             const PlotOptions& o) {
-  const std::string font_text = read_file(o.font_path);
-  const std::vector<std::uint8_t> font(font_text.begin(), font_text.end());
-  render::FigureStyle style;
-  style.width = style.height = o.map_size;
-  style.dpi = o.dpi;
-  style.font = &font;
+  const std::vector<std::uint8_t> font = read_font(o);
+  const render::FigureStyle style = map_style(o, font);
   render::TrackMapData map;
   map.title = r.track + ": QSS limit " + fixed(r.lines.min_curvature.lap_time, 2) + " s on the minimum-curvature line";
   map.cones = track.cones;

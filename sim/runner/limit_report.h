@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "autonomy/common/trajectory.h"
+#include "autonomy/planning/racing_line.h"
 #include "autonomy/planning/velocity_profile.h"
 #include "sim/runner/vehicle_report.h"
 #include "sim/world/track.h"
@@ -20,8 +21,8 @@ namespace paddock::runner {
 
 struct PlotOptions;  // plots.h
 
-// the clearance of the and the report's reference line (m)
-inline constexpr double kLimitClearance = 1.0;
+// the clearance of the report's reference line (m): the racing line's own default
+inline constexpr double kLimitClearance = planning::RacingLineParams{}.clearance;
 
 // one line and its QSS profile
 struct LimitLine {

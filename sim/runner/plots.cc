@@ -163,6 +163,26 @@ std::vector<std::string> plot_perception(const std::string& dir, const render::F
 
 }  // namespace
 
+std::vector<std::uint8_t> read_font(const PlotOptions& options) {
+  const std::string text = read_file(options.font_path);
+  return std::vector<std::uint8_t>(text.begin(), text.end());
+}
+
+render::FigureStyle map_style(const PlotOptions& options, const std::vector<std::uint8_t>& font) {
+  render::FigureStyle style;
+  style.width = style.height = options.map_size;
+  style.dpi = options.dpi;
+  style.font = &font;
+  return style;
+}
+
+render::FigureStyle chart_style(const PlotOptions& options, const std::vector<std::uint8_t>& font) {
+  render::FigureStyle style = map_style(options, font);
+  style.width = options.chart_width;
+  style.height = options.chart_height;
+  return style;
+}
+
 void write_png(const std::string& path, const render::Image& image) {
   const std::vector<std::uint8_t> png = render::encode_png(image);
   write_file_atomic(path, std::string(png.begin(), png.end()));
@@ -376,17 +396,10 @@ std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& o) 
   const world::TrackModel track = world::build_track(load_track_file(scenario.track_path));
   const std::vector<LogRow> log = parse_log_csv(read_file(dir + "/log.csv"), dir + "/log.csv");
   const SummaryLaps laps = read_summary(dir + "/summary.json");
-  const std::string font_text = read_file(o.font_path);
-  const std::vector<std::uint8_t> font(font_text.begin(), font_text.end());
+  const std::vector<std::uint8_t> font = read_font(o);
   const std::string event = events::to_string(scenario.scenario.event);
-
-  render::FigureStyle map_style;
-  map_style.width = map_style.height = o.map_size;
-  map_style.dpi = o.dpi;
-  map_style.font = &font;
-  render::FigureStyle chart_style = map_style;
-  chart_style.width = o.chart_width;
-  chart_style.height = o.chart_height;
+  const render::FigureStyle map_style = runner::map_style(o, font);
+  const render::FigureStyle chart_style = runner::chart_style(o, font);
 
   // the map: the track, and the path driven coloured by speed
   render::TrackMapData map;

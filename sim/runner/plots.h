@@ -2,6 +2,7 @@
 // the figures of a finished run, drawn from its files: DIR/scenario.ini (which
 // names the track), DIR/log.csv and DIR/summary.json. `paddock run --plots`
 // and `paddock plot DIR` both come here, so a redraw is the same picture.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,12 @@ struct PlotOptions {
 // their paths; throws UserError naming the file and
 // line of anything it cannot read
 std::vector<std::string> plot_run(const std::string& dir, const PlotOptions& options);
+
+// the options' font, read once: the styles below point into it
+std::vector<std::uint8_t> read_font(const PlotOptions& options);
+// the square map's and the charts' styles at the options' sizes and dpi
+render::FigureStyle map_style(const PlotOptions& options, const std::vector<std::uint8_t>& font);
+render::FigureStyle chart_style(const PlotOptions& options, const std::vector<std::uint8_t>& font);
 
 // the image as a PNG file at path, written atomically
 void write_png(const std::string& path, const render::Image& image);

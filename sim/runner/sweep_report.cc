@@ -151,13 +151,8 @@ std::string sweep_report(const SweepTable& t, int n) {
 std::vector<std::string> plot_sweep(const std::string& dir, const PlotOptions& options) {
   const Results r = read_results(dir);
   const SweepTable t = sweep_table(dir);
-  const std::string font_text = read_file(options.font_path);
-  const std::vector<std::uint8_t> font(font_text.begin(), font_text.end());
-  render::FigureStyle style;
-  style.width = options.chart_width;
-  style.height = options.chart_height;
-  style.dpi = options.dpi;
-  style.font = &font;
+  const std::vector<std::uint8_t> font = read_font(options);
+  const render::FigureStyle style = chart_style(options, font);
   const std::string name = fs::path(fs::absolute(dir).lexically_normal()).filename().string();
   std::vector<std::string> out;
   const auto nan = std::numeric_limits<double>::quiet_NaN();

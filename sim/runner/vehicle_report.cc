@@ -599,13 +599,8 @@ render::LineChartData ggv_chart(const VehicleReport& r) {
 }
 
 std::vector<std::string> write_vehicle_report(const VehicleReport& r, const std::string& dir, const PlotOptions& o) {
-  const std::string font_text = read_file(o.font_path);
-  const std::vector<std::uint8_t> font(font_text.begin(), font_text.end());
-  render::FigureStyle style;
-  style.width = o.chart_width;
-  style.height = o.chart_height;
-  style.dpi = o.dpi;
-  style.font = &font;
+  const std::vector<std::uint8_t> font = read_font(o);
+  const render::FigureStyle style = chart_style(o, font);
   const std::vector<std::string> paths = {dir + "/vehicle_report.json", dir + "/ggv.png"};
   write_file_atomic(paths[0], vehicle_report_json(r));
   write_png(paths[1], render::draw_line_chart(ggv_chart(r), style).image);
