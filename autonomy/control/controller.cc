@@ -113,7 +113,9 @@ ControlOutput Controller::update(const ControlInput& in) {
   d.s = base.s;
 
   // Stanley at the front axle: e > 0 when the path lies left of it
-  const double psi_e = wrap_angle(fa.ref.heading - pose.yaw);
+  const double preview = v * params_.stanley.preview_time;
+  const double path_heading = preview > 0.0 ? traj.at(fa.s + preview).heading : fa.ref.heading;
+  const double psi_e = wrap_angle(path_heading - pose.yaw);
   const double e = -fa.offset;
   const double r_traj = v * fa.ref.curvature;  // yaw rate of the trajectory (rad/s)
   d.lateral_error = fa.offset;

@@ -26,12 +26,18 @@ struct StanleyParams {
   // theta_ss: the front axle's slip angle in a steady turn, see
   // steady_state_yaw
   bool use_steady_state_yaw = true;
+  // the heading term reads the path this long ahead of the front axle (at
+  // v * preview_time): the steering actuator and the tyres' relaxation lag
+  // the command, so a car at speed that steers for the path where it is
+  // turns in late and unwinds late at a corner's exit. 0: the paper's law
+  double preview_time = 0.0;
 
   template <class V>
   void visit(V& v) {
     v(PADDOCK_PARAM(k), {"1/s", params::in(0.0, 100.0), "Stanley cross-track gain"});
     v(PADDOCK_PARAM(k_soft), {"m/s", params::above_up_to(0.0, 100.0), "Stanley softening speed"});
     v(PADDOCK_PARAM(use_steady_state_yaw), "add Hoffmann's steady-state yaw to Stanley");
+    v(PADDOCK_PARAM(preview_time), {"s", params::in(0.0, 1.0), "the heading term reads the path this far ahead of the front axle"});
   }
 };
 

@@ -45,20 +45,21 @@ bool triangulate_and_search(const std::vector<Cone>& cone_map, const Pose2& vehi
   return true;
 }
 
-// the boundaries of a closed lap: every mapped cone within kBoundaryReach
-// of the lap's centreline, on the side of it where it lies, in the order of
-// its projection along the lap (the cones the lap passes: the nearest part
-// of the lap claims a cone, so a neighbouring leg's cones are not this one's)
+// the boundaries of a path (a closed lap, or an open path ahead): every
+// mapped cone within kBoundaryReach of its centreline, on the side of it
+// where it lies, in the order of its projection along the path (the cones
+// the path passes: the nearest part of the path claims a cone, so a
+// neighbouring leg's cones are not this one's)
 constexpr double kBoundaryReach = 3.5;  // m: half the widest FS track and a cone's offset
 
-void lap_boundaries(const std::vector<Vec2>& lap, const std::vector<Cone>& cones, const Triangulation& tri,
-                    std::vector<Vec2>& left, std::vector<Vec2>& right) {
+void path_boundaries(const std::vector<Vec2>& path, bool closed, const std::vector<Cone>& cones,
+                     const Triangulation& tri, std::vector<Vec2>& left, std::vector<Vec2>& right) {
   std::vector<std::pair<double, Vec2>> l, r;
   for (std::size_t i = 0; i < cones.size(); ++i) {
     const Cone& c = cones[i];
     // a doubled cone once (the triangulation merged it), a non-finite one never
     if (i >= tri.representative.size() || tri.representative[i] != i) continue;
-    const Projection p = project(lap, true, c.position);
+    const Projection p = project(path, closed, c.position);
     if (p.distance > kBoundaryReach) continue;
     (p.signed_offset > 0.0 ? l : r).push_back({p.s, c.position});
   }
@@ -80,7 +81,7 @@ bool plan_racing_line(PlanResult& out, const std::vector<Cone>& cones, const Pat
     out.racing_fallback = "racing line: not a planned lap";
     return false;
   }
-  lap_boundaries(out.smoothed, cones, out.triangulation, out.left_boundary, out.right_boundary);
+  path_boundaries(out.smoothed, true, cones, out.triangulation, out.left_boundary, out.right_boundary);
   const RacingLine line = min_curvature_line(out.smoothed, out.left_boundary, out.right_boundary, true, params.racing);
   if (!line.ok()) {
     out.racing_fallback = line.reason;
@@ -185,6 +186,28 @@ PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, do
   if (reference.profile.limits == VelocityProfileParams::Ggv) {
     reference.profile.margin_lateral = params.explore_margin_lateral;
     reference.profile.margin_longitudinal = params.explore_margin_longitudinal;
+  }
+  // an open path with line = min_curvature: the racing line as far as the
+  // map is known, from the car (its offset held at 0, leaving along the
+  // car's heading) to where the seen track ends (back on the centreline
+  // there); the centreline when it fails
+  if (!out.closed && params.line == PathPlannerParams::MinCurvature) {
+    path_boundaries(out.smoothed, false, cone_map, out.triangulation, out.left_boundary, out.right_boundary);
+    const RacingLine line =
+        min_curvature_line(out.smoothed, out.left_boundary, out.right_boundary, false, params.racing, true, vehicle.yaw);
+    out.racing_fallback = line.reason;
+    if (line.ok()) {
+      const SplineFit fit = fit_spline(line.points, false);
+      out.racing_fallback = fit.ok() ? "" : "racing line: " + fit.reason;
+      if (fit.ok()) {
+        ReferenceResult racing = reference_from_spline(fit.spline, reference, v_start, v_end);
+        if (racing.ok()) {
+          out.racing_line = line.points;
+          return with_reference(std::move(out), std::move(racing));
+        }
+        out.racing_fallback = "racing line: " + racing.reason;
+      }
+    }
   }
   ReferenceResult ref = build_reference(out.smoothed, out.closed, reference, v_start, v_end);
   // the spline can swing back towards a cone between the points: push the

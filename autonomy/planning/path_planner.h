@@ -23,10 +23,11 @@
 namespace paddock::planning {
 
 struct PathPlannerParams {
-  // the line a trackdrive's locked lap is driven on (plan_locked_lap): the
-  // paper's smoothed centreline, or the minimum-curvature line inside the
-  // lap's mapped boundaries (plan_racing_line); every path plan_path gives
-  // (exploring: autocross, a trackdrive's first lap) follows the centreline
+  // the line the car drives: the paper's smoothed centreline, or the
+  // minimum-curvature line inside the mapped boundaries: a trackdrive's
+  // locked lap's (plan_locked_lap, plan_racing_line), and every open path
+  // plan_path gives while exploring (autocross, a trackdrive's first lap)
+  // as far as the map shows the track
   enum Line { Centreline, MinCurvature };
   static constexpr params::Choice<Line> kLineNames[] = {{"centreline", Centreline}, {"min_curvature", MinCurvature}};
   Line line = Centreline;
@@ -57,7 +58,7 @@ struct PathPlannerParams {
 
   template <class V>
   void visit(V& v) {
-    v(PADDOCK_PARAM(line), kLineNames, "a full lap's line: the centreline, or the minimum-curvature racing line");
+    v(PADDOCK_PARAM(line), kLineNames, "the line driven: the centreline, or the minimum-curvature racing line");
     v.section(PADDOCK_PARAM(search), "the reward-based centreline search");
     v.section(PADDOCK_PARAM(smoothing), "the centreline's smoothing");
     v.section(PADDOCK_PARAM(clearance), "the smoothed points are pushed clear of the cones");
@@ -85,10 +86,10 @@ struct PlanResult {
   bool closed = false;            // a full lap: closed spline and closed velocity profile
   Triangulation triangulation;    // for plots: the grey layer, the midpoints
   CentrelineResult search;        // the search's points, scores and stop reason
-  // a full lap with line = min_curvature: the racing line's optimised points
-  // (empty when the lap follows the centreline), its boundaries from the
-  // lap's cones, and why the centreline was kept (empty when
-  // the racing line is driven)
+  // with line = min_curvature: the racing line's optimised points (empty
+  // when the path follows the centreline), its boundaries from the path's
+  // cones, and why the centreline was kept (empty when the racing line is
+  // driven)
   std::vector<Vec2> racing_line;
   std::vector<Vec2> left_boundary, right_boundary;
   std::string racing_fallback;
@@ -110,7 +111,11 @@ struct PlanResult {
 // wanted yet (a car that has not driven far enough for the search's lap to be
 // trusted as the circuit, e.g. a long-range sensor that already shows the
 // whole of it): a lap the search closes is planned as an open path along it
-// from the vehicle, once around, ending short of the vehicle. Never throws.
+// from the vehicle, once around, ending short of the vehicle. With line =
+// min_curvature an open path is the minimum-curvature line (params.racing)
+// inside the boundaries of the cones along it, from the vehicle (leaving
+// along its heading) to the centreline's end; the centreline where that
+// fails (racing_fallback says why). Never throws.
 PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, double speed,
                      const PathPlannerParams& params = {}, bool lap = true);
 

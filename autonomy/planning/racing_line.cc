@@ -5,9 +5,10 @@
 #include <cstddef>
 #include <limits>
 #include <map>
-#include <utility>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <utility>
 
 #include <ceres/ceres.h>
 #include <IpIpoptApplication.hpp>
@@ -199,6 +200,11 @@ class MinCurvatureNlp : public Ipopt::TNLP {
 // -1 when it failed (the offsets are then left as they were)
 int solve(const std::vector<Vec2>& r, const std::vector<Vec2>& normal, bool closed, int max_iterations,
           const std::vector<double>& lower, const std::vector<double>& upper, std::vector<double>& offset) {
+  // IPOPT's linear solver (Debian's sequential MUMPS) keeps global state: one
+  // solve at a time in a process, whose sweep and tune runs are threads and
+  // whose runs solve their limit lap on a thread of its own
+  static std::mutex one_at_a_time;
+  const std::lock_guard<std::mutex> lock(one_at_a_time);
   std::vector<double> x = offset;
   Ipopt::SmartPtr<MinCurvatureNlp> nlp = new MinCurvatureNlp(r, normal, closed, lower, upper, x);
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
@@ -233,7 +239,8 @@ double curvature_cost(const std::vector<Vec2>& pts, bool closed) {
 }
 
 RacingLine min_curvature_line(const std::vector<Vec2>& reference, const std::vector<Vec2>& left,
-                              const std::vector<Vec2>& right, bool closed, const RacingLineParams& params) {
+                              const std::vector<Vec2>& right, bool closed, const RacingLineParams& params,
+                              bool pin_ends, std::optional<double> start_heading) {
   RacingLine out;
   if (const std::string bad = params::validate(params); !bad.empty()) {
     out.reason = "racing line: " + bad;
@@ -280,6 +287,16 @@ RacingLine min_curvature_line(const std::vector<Vec2>& reference, const std::vec
     if (lo > hi) lo = hi = 0.5 * (lo + hi);  // narrower than twice the clearance: midway
     out.lower[i] = lo;
     out.upper[i] = hi;
+  }
+  if (pin_ends && !closed) {
+    out.lower.front() = out.upper.front() = out.lower.back() = out.upper.back() = 0.0;
+    // r_1 + a n_1 - r_0 along h: cross(h, r_1 - r_0) + a cross(h, n_1) = 0
+    const Vec2 h{std::cos(start_heading.value_or(0.0)), std::sin(start_heading.value_or(0.0))};
+    const double c = cross(h, normal[1]);
+    if (start_heading && std::isfinite(*start_heading) && n > 2 && std::abs(c) > 1e-6) {
+      const double a = std::clamp(-cross(h, r[1] - r[0]) / c, out.lower[1], out.upper[1]);
+      out.lower[1] = out.upper[1] = a;
+    }
   }
 
   // the problem: one offset per point, one curvature residual per inner

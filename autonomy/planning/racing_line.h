@@ -23,6 +23,7 @@
 // distance of a solved point to a boundary falls short of the clearance
 // (the boundary bends towards it), that bound is tightened and the problem
 // solved again (up to 4 rounds).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,10 +78,15 @@ struct RacingLine {
 // polylines, closed like the reference). Where the boundaries are closer
 // together than twice the clearance, the point stays midway between them.
 // Fewer than 3 (closed) or 4 (open) resampled points, NaN or bad parameters
-// give a reason; nothing throws. Open lines keep their end points' offsets
-// free but have no curvature term at the ends.
+// give a reason; nothing throws. Open lines have no curvature term at the
+// ends; their end points' offsets are free, or held at 0 with pin_ends (a
+// path that starts at the car and ends where the known track ends), and
+// with start_heading (rad) as well the second point is held where the line
+// leaves its first along that heading (the car's: a line that starts at an
+// angle to the car asks a step of steering), as far as its bounds allow.
 RacingLine min_curvature_line(const std::vector<Vec2>& reference, const std::vector<Vec2>& left,
-                              const std::vector<Vec2>& right, bool closed, const RacingLineParams& params = {});
+                              const std::vector<Vec2>& right, bool closed, const RacingLineParams& params = {},
+                              bool pin_ends = false, std::optional<double> start_heading = std::nullopt);
 
 // sum kappa_i^2 ds_i of a polyline with Menger curvature (the cost above):
 // closed, every point; open, the inner points

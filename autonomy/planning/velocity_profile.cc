@@ -219,6 +219,30 @@ VelocityProfile solve_velocity_profile(const std::vector<double>& curvature,
   return out;
 }
 
+std::size_t catch_up_profile(std::vector<double>& speed, const std::vector<double>& curvature,
+                             const std::vector<double>& segment_lengths, bool closed, std::size_t from,
+                             double v0, const VelocityProfileParams& params) {
+  const std::size_t n = speed.size();
+  if (n < 2 || curvature.size() != n || segment_lengths.size() != (closed ? n : n - 1) || from >= n ||
+      !std::isfinite(v0))
+    return 0;
+  v0 = std::max(v0, 0.0);
+  if (v0 >= speed[from]) return 0;
+  speed[from] = v0;
+  std::size_t lowered = 1;
+  // forward steps from `from`: each lowers the next point or, once the car's
+  // speed is back on the profile, ends the catch-up; a closed path goes at
+  // most once round
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    const std::size_t i = (from + k) % n;
+    const std::size_t j = i + 1;
+    if (j == n && !closed) break;
+    if (!forward_step(speed, curvature, i, j % n, segment_lengths[i], params)) break;
+    ++lowered;
+  }
+  return lowered;
+}
+
 double profile_time(const std::vector<double>& speed, const std::vector<double>& segment_lengths,
                     bool closed) {
   const std::size_t n = speed.size();

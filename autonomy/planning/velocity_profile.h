@@ -82,11 +82,11 @@ struct VelocityProfileParams {
   std::vector<double> ggv_accel = {14.60, 14.60, 14.57, 14.29, 11.18, 8.78, 6.45, 0.0};
   std::vector<double> ggv_brake = {14.40, 14.40, 14.73, 15.39, 16.29, 17.55, 19.01, 19.01};
   // the shares of the envelope planned with (limits = ggv): the rest is the
-  // reserve for tracking, localisation and perception errors. Measured on
-  // FSG 2023 trackdrive (raw sensors, FastSLAM, the racing line 1.2 m from
-  // the boundaries, open paths at 0.6): 0.75 laps in 24.7 s clean, 0.8 in
-  // 23.9 s with 2 cones hit where the line leaves the last corner along the
-  // cones, 0.9 in 22.6 s with the tracking error reaching 1 m
+  // reserve for tracking, localisation and perception errors. 0.75 each is
+  // safe with the combined law; scenarios/racing.ini plans with 0.95 and 0.75
+  // and the Stanley law, as `paddock tune scenarios/tunes/racing.ini` chose
+  // over three trackdrives (a car loses its line under braking and drive in
+  // a turn sooner than in the turn alone)
   double margin_lateral = 0.75;
   double margin_longitudinal = 0.75;
 
@@ -155,6 +155,20 @@ VelocityProfile solve_velocity_profile(const std::vector<double>& curvature,
                                        const VelocityProfileParams& params,
                                        std::optional<double> v_start = std::nullopt,
                                        std::optional<double> v_end = std::nullopt);
+
+// a profile caught up from the car's state: the speeds lowered, from point
+// `from` on, to what the car reaches from speed v0 there when it accelerates
+// as the solver's forward pass does (within the limits at each point's speed
+// and curvature), round the loop when closed, until the car's speed meets the
+// profile. A faster lap taking over from a slower one starts this way, so
+// that its speed error is closed within the tyres and not by the speed loop
+// at full throttle in a turn. Returns how many points were lowered (0 when
+// v0 is already at or above the profile at `from`); `speed` is unchanged
+// when an input is bad (sizes as for solve_velocity_profile, `from` out of
+// range, v0 not finite).
+std::size_t catch_up_profile(std::vector<double>& speed, const std::vector<double>& curvature,
+                             const std::vector<double>& segment_lengths, bool closed, std::size_t from,
+                             double v0, const VelocityProfileParams& params);
 
 // time to drive the profile (s), constant acceleration along each segment:
 // t = sum 2 ds_i / (v_i + v_i+1), including the closing segment when closed

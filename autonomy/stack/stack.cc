@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "autonomy/common/polyline.h"
+#include "autonomy/planning/velocity_profile.h"
 
 namespace paddock::stack {
 
@@ -250,6 +251,44 @@ void Stack::plan(const hal::StateEstimate& st) {
   if (spec_.gates.empty()) learn_gates(st.pose, st.stamp, st.vx);
 }
 
+void Stack::catch_up(const hal::StateEstimate& st) {
+  // the lap's profile from the car's speed where it takes over: a lap faster
+  // than the path it replaces (the racing line after the exploring lap)
+  // ramps up at what the tyres allow, not at the speed loop's full throttle
+  // in a turn; the lap's own speeds come back once the ramp has met them
+  std::vector<TrajectoryPoint>& pts = trajectory_.points;
+  const std::size_t n = pts.size();
+  if (n < 2 || !trajectory_.closed) return;
+  std::vector<double> speed(n), kappa(n), ds(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    speed[i] = pts[i].speed;
+    kappa[i] = pts[i].curvature;
+    ds[i] = (i + 1 < n ? pts[i + 1].s : trajectory_.length) - pts[i].s;
+  }
+  if (std::any_of(ds.begin(), ds.end(), [](double d) { return !(d > 0.0); })) return;
+  const double s_car = project(trajectory_, st.pose.position(), 0.0, 0.0).s;
+  const auto after = std::upper_bound(pts.begin(), pts.end(), s_car,
+                                      [](double s, const TrajectoryPoint& p) { return s < p.s; });
+  const std::size_t from = after == pts.begin() ? 0 : static_cast<std::size_t>(after - pts.begin()) - 1;
+  lap_speed_ = speed;
+  // until it has caught up the car is still leaving the exploring path: it
+  // accelerates at the exploring margins
+  planning::VelocityProfileParams ramp_profile = params_.planning.reference.profile;
+  if (ramp_profile.limits == planning::VelocityProfileParams::Ggv) {
+    ramp_profile.margin_lateral = params_.planning.explore_margin_lateral;
+    ramp_profile.margin_longitudinal = params_.planning.explore_margin_longitudinal;
+  }
+  const std::size_t lowered = planning::catch_up_profile(speed, kappa, ds, true, from, st.vx, ramp_profile);
+  if (lowered == 0) return;
+  double ramp = 0.0;  // from the car to the ramp's last point
+  for (std::size_t k = 0; k < lowered; ++k) {
+    const std::size_t i = (from + k) % n;
+    pts[i].speed = speed[i];
+    if (k + 1 < lowered) ramp += ds[i];
+  }
+  catch_up_until_ = driven_ + ramp;
+}
+
 double Stack::finish_approach_cap(Vec2 base) const {
   const MissionParams& mp = params_.mission;
   constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -393,7 +432,14 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
         std::abs(wrap_angle(on.ref.heading - st.pose.yaw)) < params_.mission.lap_switch_heading) {
       trajectory_ = std::move(pending_lap_);
       pending_lap_ = Trajectory{};
+      catch_up(st);
     }
+  }
+  if (catch_up_until_ && driven_ >= *catch_up_until_) {
+    // caught up: the lap's own speeds from here on
+    for (std::size_t i = 0; i < trajectory_.points.size() && i < lap_speed_.size(); ++i)
+      trajectory_.points[i].speed = lap_speed_[i];
+    catch_up_until_.reset();
   }
   driven_ += speed * dt;
 

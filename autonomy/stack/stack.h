@@ -234,6 +234,8 @@ class Stack {
   // on the last lap: the fastest speed from which the car can still brake to
   // the finish speed that stops within the stop distance (infinite otherwise)
   double finish_approach_cap(Vec2 base) const;
+  // the lap that just took over, ramped up from the car's speed
+  void catch_up(const hal::StateEstimate& st);
   void count_crossings(Vec2 base, TimeNs now, double speed);
   // counts a crossing made at driven distance `at` (m) unless it is within the
   // refractory distance of the last one; true when counted
@@ -265,6 +267,8 @@ class Stack {
   planning::PlanResult last_plan_;
   std::vector<Cone> last_plan_cones_;
   Trajectory pending_lap_;                  // the closed lap, waiting for a smooth handover
+  std::vector<double> lap_speed_;           // the lap's own speeds while its first metres ramp up to them
+  std::optional<double> catch_up_until_;    // driven_ where the ramp meets the lap's speeds (m)
   std::vector<Segment> gates_;              // known and learned timekeeping gates
   std::optional<Vec2> last_base_position_;  // for the gate crossing test
   double driven_ = 0.0;                     // distance driven (m)

@@ -199,6 +199,24 @@ TEST(Controller, SteadyStateYawPointsIntoTheTurn) {
   EXPECT_NEAR(a.diagnostics.delta_st - b.diagnostics.delta_st, a.diagnostics.theta_ss, 1e-12);
 }
 
+TEST(Controller, HeadingPreviewReadsThePathAhead) {
+  // on a left circle of radius 15 m at 10 m/s, a preview of 0.2 s reads the
+  // path heading 2 m further round: 2 / 15 rad more to the left
+  const Trajectory t = circle(15.0, 10.0);
+  ControlParams now = mode(LateralMode::Stanley);
+  ControlParams ahead = now;
+  ahead.stanley.preview_time = 0.2;
+  const ControlInput in = input_at(t, 15.0, 0.0, 0.5 * kPi, 10.0);
+  const ControlOutput a = Controller(ahead).update(in);
+  const ControlOutput b = Controller(now).update(in);
+  EXPECT_NEAR(a.diagnostics.heading_error - b.diagnostics.heading_error, 2.0 / 15.0, 1e-3);
+  EXPECT_NEAR(a.steering_angle - b.steering_angle, 2.0 / 15.0, 1e-3);
+  // on a straight the path ahead heads the same way: no change
+  const Trajectory line = straight(-10.0, 100.0, 10.0);
+  const ControlInput off = input_at(line, 0.0, -0.5, 0.1, 10.0);
+  EXPECT_DOUBLE_EQ(Controller(ahead).update(off).steering_angle, Controller(now).update(off).steering_angle);
+}
+
 TEST(Controller, YawRateDampingOpposesExcessYaw) {
   // yawing left faster than the path asks -> less left steering
   const Trajectory t = circle(15.0, 8.0);

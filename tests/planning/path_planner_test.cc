@@ -448,6 +448,58 @@ TEST(PathPlannerTracks, PartialMapGivesAnOpenPathThatEndsAtRest) {
   }
 }
 
+TEST(PathPlannerTracks, PartialMapRacesAsFarAsItIsKnown) {
+  // line = min_curvature on an open path (an autocross, a first lap): the
+  // racing line from the car to where the seen track ends, held on the
+  // centreline at both ends, inside the track, bending less than the
+  // centreline's open path over the same stretch
+  const double seen = 20.0;  // m around the start pose
+  PathPlannerParams racing;
+  racing.line = PathPlannerParams::MinCurvature;
+  racing.reference.profile.limits = VelocityProfileParams::Ggv;
+  PathPlannerParams centre = racing;
+  centre.line = PathPlannerParams::Centreline;
+  for (const auto& name : kCircuits) {
+    const TrackFile t = read_track(name);
+    const Boundaries b = boundaries(t);
+    const Pose2 start = start_pose(t);
+    std::vector<Cone> near;
+    for (const Cone& c : t.cones)
+      if (distance(c.position, start.position()) <= seen) near.push_back(c);
+    const PlanResult plan = plan_path(near, start, 3.0, racing);
+    const PlanResult base = plan_path(near, start, 3.0, centre);
+    ASSERT_TRUE(plan.ok() && base.ok()) << name << ": " << plan.reason << base.reason;
+    ASSERT_FALSE(plan.closed);
+    ASSERT_FALSE(plan.racing_line.empty()) << name << ": " << plan.racing_fallback;
+    EXPECT_TRUE(base.racing_line.empty());
+    // pinned: from the car, to the centreline's end
+    EXPECT_LT(distance(plan.racing_line.front(), start.position()), 1e-6) << name;
+    EXPECT_LT(distance(plan.racing_line.back(), plan.smoothed.back()), 0.5) << name;
+    EXPECT_NEAR(plan.trajectory.points.front().x, start.x, 1e-6) << name;
+    EXPECT_NEAR(plan.trajectory.points.front().y, start.y, 1e-6) << name;
+    EXPECT_EQ(plan.trajectory.points.back().speed, 0.0) << name;
+    const Fit fit = fit_in(b, trajectory_points(plan.trajectory));
+    EXPECT_TRUE(fit.inside) << name;
+    EXPECT_GT(fit.min_clearance, kPartialMargin) << name;
+    // it bends less: sum kappa^2 ds along the driven trajectories
+    const auto bending = [](const Trajectory& tr) {
+      double sum = 0.0;
+      for (std::size_t i = 0; i + 1 < tr.points.size(); ++i) {
+        const double k = tr.points[i].curvature;
+        sum += k * k * (tr.points[i + 1].s - tr.points[i].s);
+      }
+      return sum;
+    };
+    const double b_racing = bending(plan.trajectory), b_centre = bending(base.trajectory);
+    std::printf("partial racing %-18s sum kappa^2 ds %.4f against %.4f 1/m, %.2f s against %.2f s, clearance %.2f m\n",
+                name.c_str(), b_racing, b_centre, lap_time(plan.trajectory), lap_time(base.trajectory),
+                fit.min_clearance);
+    // (where the stretch is all but straight, below 1e-3 1/m, a radius of
+    // ~140 m over 20 m, leaving along the car's heading may bend it more)
+    EXPECT_LT(b_racing, std::max(b_centre, 1e-3)) << name;
+  }
+}
+
 // ---- abnormal maps: no trajectory and a reason ----------------------------------------
 
 TEST(PathPlanner, AbnormalInputsGiveNoTrajectoryAndAReason) {

@@ -128,6 +128,58 @@ TEST(RacingLine, NarrowerThanTwiceTheClearanceStaysMidway) {
   for (std::size_t i = 0; i < line.points.size(); ++i) EXPECT_NEAR(line.offset[i], 0.0, 2e-3);
 }
 
+TEST(RacingLine, PinnedEndsStayOnTheReference) {
+  // an open half of a ring of radius 10 between boundaries at 8 and 12: the
+  // free line moves its ends, the pinned one keeps them and still bends less
+  std::vector<Vec2> ref, left, right;
+  for (int i = 0; i <= 60; ++i) {
+    const double a = kPi * i / 60.0;
+    const Vec2 u{std::cos(a), std::sin(a)};
+    ref.push_back(10.0 * u);
+    left.push_back(8.0 * u);
+    right.push_back(12.0 * u);
+  }
+  RacingLineParams p;
+  p.clearance = 0.5;
+  const RacingLine free_line = min_curvature_line(ref, left, right, false, p);
+  const RacingLine pinned = min_curvature_line(ref, left, right, false, p, true);
+  ASSERT_TRUE(free_line.ok() && pinned.ok()) << free_line.reason << pinned.reason;
+  EXPECT_DOUBLE_EQ(pinned.offset.front(), 0.0);
+  EXPECT_DOUBLE_EQ(pinned.offset.back(), 0.0);
+  EXPECT_LT(distance(pinned.points.front(), ref.front()), 1e-9);
+  EXPECT_GT(std::abs(free_line.offset.front()) + std::abs(free_line.offset.back()), 0.5);
+  EXPECT_LE(pinned.cost, pinned.cost_reference + 1e-12);
+  EXPECT_LE(free_line.cost, pinned.cost + 1e-9);
+  for (std::size_t i = 0; i < pinned.offset.size(); ++i) {
+    EXPECT_GE(pinned.offset[i], -1.5 - 1e-6);
+    EXPECT_LE(pinned.offset[i], 1.5 + 1e-6);
+  }
+}
+
+TEST(RacingLine, StartHeadingHoldsTheSecondPointOnTheCarsHeading) {
+  // a straight 3 m corridor along x, the car at its start heading 0.2 rad
+  // left: the line leaves along that heading (the second point on the ray),
+  // a heading the bounds cannot follow is clamped to them
+  std::vector<Vec2> ref, left, right;
+  for (int i = 0; i <= 30; ++i) {
+    ref.push_back({static_cast<double>(i), 0.0});
+    left.push_back({static_cast<double>(i), 3.0});
+    right.push_back({static_cast<double>(i), -3.0});
+  }
+  RacingLineParams p;
+  p.clearance = 1.0;
+  const RacingLine line = min_curvature_line(ref, left, right, false, p, true, 0.2);
+  ASSERT_TRUE(line.ok()) << line.reason;
+  const Vec2 d = line.points[1] - line.points[0];
+  EXPECT_NEAR(std::atan2(d.y, d.x), 0.2, 1e-9);
+  EXPECT_DOUBLE_EQ(line.offset.front(), 0.0);
+  EXPECT_DOUBLE_EQ(line.offset.back(), 0.0);
+  const RacingLine steep = min_curvature_line(ref, left, right, false, p, true, 1.5);
+  ASSERT_TRUE(steep.ok()) << steep.reason;
+  EXPECT_NEAR(steep.offset[1], steep.upper[1], 1e-12);
+  EXPECT_NEAR(steep.upper[1], 2.0, 1e-9);
+}
+
 TEST(RacingLine, BadInputGivesAReason) {
   const std::vector<Vec2> ref = circle(13.0, 100), left = circle(10.0, 100), right = circle(16.0, 100);
   std::vector<Vec2> bad = ref;

@@ -480,5 +480,57 @@ TEST(VelocityProfileGgv, BadEnvelopesGiveAReason) {
   EXPECT_NE(prof.reason.find("ggv_lateral[1]"), std::string::npos) << prof.reason;
 }
 
+// catch_up_profile: the forward pass from the car's state
+TEST(VelocityProfileCatchUp, RampFromTheCarsSpeedMatchesTheClosedForm) {
+  // a closed 200 m loop of straight (a lap planned at 24.9 m/s everywhere)
+  // and a constant 4 m/s^2 of acceleration: from 5 m/s at point 380 (of 400,
+  // 0.5 m apart) the speed is sqrt(25 + 8 s) until it meets 24.9 m/s after
+  // (24.9^2 - 25) / 8 = 74.4 m, round the loop's end
+  const VelocityProfileParams q = ggv_params(15.0, 15.0, 4.0, 4.0, 10.0, 10.0);
+  const std::size_t n = 400;
+  const std::vector<double> kappa(n, 0.0), ds(n, 0.5);
+  std::vector<double> v(n, 24.9);
+  const std::size_t from = 380;
+  const std::size_t lowered = catch_up_profile(v, kappa, ds, true, from, 5.0, q);
+  EXPECT_EQ(lowered, 149u);  // the points up to 74 m (sqrt(617) = 24.84 m/s)
+  for (std::size_t k = 0; k < 149; ++k) {
+    const double s = 0.5 * static_cast<double>(k);
+    EXPECT_NEAR(v[(from + k) % n], std::sqrt(25.0 + 8.0 * s), 1e-9) << "at " << s << " m";
+  }
+  // nothing after the ramp, nothing before the car
+  for (std::size_t i = (from + 149) % n; i < from; ++i) EXPECT_DOUBLE_EQ(v[i], 24.9) << i;
+}
+
+TEST(VelocityProfileCatchUp, TurnsLeaveLessToAccelerateAndAFastCarNothing) {
+  // on a circle the friction ellipse leaves less than on a straight: the
+  // ramp is longer; at or above the profile nothing changes
+  const VelocityProfileParams q = ggv_params(15.0, 15.0, 4.0, 4.0, 10.0, 10.0);
+  const std::size_t n = 400;
+  const std::vector<double> straight_k(n, 0.0), circle_k(n, 1.0 / 60.0), ds(n, 0.5);
+  std::vector<double> a(n, 25.0), b(n, 25.0);
+  const std::size_t on_straight = catch_up_profile(a, straight_k, ds, true, 0, 5.0, q);
+  const std::size_t on_circle = catch_up_profile(b, circle_k, ds, true, 0, 5.0, q);
+  EXPECT_GT(on_circle, on_straight);
+  for (std::size_t i = 1; i < on_straight; ++i) EXPECT_LT(b[i], a[i]) << i;
+  std::vector<double> c(n, 25.0);
+  EXPECT_EQ(catch_up_profile(c, straight_k, ds, true, 7, 25.0, q), 0u);
+  EXPECT_EQ(catch_up_profile(c, straight_k, ds, true, 7, 30.0, q), 0u);
+  EXPECT_EQ(c, std::vector<double>(n, 25.0));
+}
+
+TEST(VelocityProfileCatchUp, OpenPathsStopAtTheirEndAndBadInputChangesNothing) {
+  const VelocityProfileParams q = ggv_params(15.0, 15.0, 4.0, 4.0, 10.0, 10.0);
+  const Path path = straight(20.0, 0.5);  // 41 points: too short to catch up
+  std::vector<double> v(path.kappa.size(), 25.0);
+  EXPECT_EQ(catch_up_profile(v, path.kappa, path.ds, false, 0, 5.0, q), v.size());
+  EXPECT_NEAR(v.back(), std::sqrt(25.0 + 8.0 * 20.0), 1e-9);
+  const std::vector<double> before(path.kappa.size(), 25.0);
+  std::vector<double> w = before;
+  EXPECT_EQ(catch_up_profile(w, path.kappa, path.ds, false, w.size(), 5.0, q), 0u);  // from out of range
+  EXPECT_EQ(catch_up_profile(w, path.kappa, path.ds, true, 0, 5.0, q), 0u);           // closed needs n lengths
+  EXPECT_EQ(catch_up_profile(w, path.kappa, path.ds, false, 0, std::numeric_limits<double>::quiet_NaN(), q), 0u);
+  EXPECT_EQ(w, before);
+}
+
 }  // namespace
 }  // namespace paddock::planning
