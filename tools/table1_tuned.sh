@@ -32,6 +32,9 @@ sets_of() {
        /^[a-zA-Z_]/ && s != "" { print "--set " s "." $1 "=" $3 }' "$1"
 }
 
+# the paper's stack (the shipped scenarios race)
+paper="$(sets_of "$root/scenarios/paper.ini")"
+
 # every run side by side (as many as cores)
 jobs="$(nproc)"
 for c in "${controllers[@]}"; do
@@ -41,7 +44,7 @@ for c in "${controllers[@]}"; do
       extra=""
       [ "$tuning" = tuned ] && extra="$(sets_of "$root/runs/table1_$c/best.ini")"
       # shellcheck disable=SC2086
-      "$bin" run "$root/scenarios/$t.ini" --set autonomy.perception=ground_truth --set autonomy.slam=ground_truth \
+      "$bin" run "$root/scenarios/$t.ini" $paper --set autonomy.perception=ground_truth --set autonomy.slam=ground_truth \
         --set control.lateral="$c" $extra --quiet --out "$out/$c.$t.$tuning" >/dev/null 2>"$out/$c.$t.$tuning.err" &
     done
   done

@@ -25,8 +25,9 @@ const LoopRun& default_run() {
   static const LoopRun r = [] {
     LoopRun out;
     // the ground-truth centreline: the reference is known, so the laps can be
-    // checked against it (and the cones need not be perceived)
-    out.scenario = load_scenario(kRoot + "/scenarios/fsg_2023_trackdrive.ini",
+    // checked against it (and the cones need not be perceived); the paper's
+    // stack, whose profile the centreline was planned for
+    out.scenario = load_scenario(kRoot + "/scenarios/fsg_2023_trackdrive_paper.ini",
                                  {"autonomy.planner=oracle", "autonomy.perception=ground_truth"});
     out.track = world::build_track(load_track_file(out.scenario.track_path));
     out.result = run(out.scenario, out.track);

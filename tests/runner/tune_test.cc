@@ -38,15 +38,19 @@ double json_number(const std::string& json, const std::string& key) {
   return std::stod(m[1]);
 }
 
-// the oracle run of FSG 2023 autocross with `sets`, as a user runs it
+// the oracle run of FSG 2023 autocross with the paper's stack (the tune
+// file's) and `sets`, as a user runs it
 struct Plain {
   double total = NAN;
   int doo = -1;
   bool finished = false;
 };
 Plain plain_run(const std::string& sets, const std::string& name) {
-  const auto o = testing::run_paddock("run " + kRoot +
-                                      "/scenarios/fsg_2023_autocross.ini --set autonomy.planner=oracle "
+  const std::string scenario = scratch(name) + ".ini";
+  std::ofstream(scenario) << "include = " << kRoot << "/scenarios/fsg_2023_autocross.ini\ninclude = " << kRoot
+                          << "/scenarios/paper.ini\n";
+  const auto o = testing::run_paddock("run " + scenario +
+                                      " --set autonomy.planner=oracle "
                                       "--set autonomy.perception=ground_truth --set autonomy.slam=ground_truth " +
                                       sets + " --json --out " + scratch(name));
   Plain p;
