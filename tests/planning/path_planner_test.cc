@@ -415,15 +415,21 @@ TEST(PathPlannerTracks, PerceptionErrorsOnFsg2019AndFsg2023) {
 
 // ---- partial maps: what the car sees at the start -----------------------------------
 
+// the cones within `seen` m of the start pose
+std::vector<Cone> cones_near(const std::vector<Cone>& cones, const Pose2& start, double seen) {
+  std::vector<Cone> near;
+  for (const Cone& c : cones)
+    if (distance(c.position, start.position()) <= seen) near.push_back(c);
+  return near;
+}
+
 TEST(PathPlannerTracks, PartialMapGivesAnOpenPathThatEndsAtRest) {
   const double seen = 20.0;  // m around the start pose
   for (const auto& name : kCircuits) {
     const TrackFile t = read_track(name);
     const Boundaries b = boundaries(t);
     const Pose2 start = start_pose(t);
-    std::vector<Cone> near;
-    for (const Cone& c : t.cones)
-      if (distance(c.position, start.position()) <= seen) near.push_back(c);
+    const std::vector<Cone> near = cones_near(t.cones, start, seen);
     const double speed = 3.0;  // m/s
     const PlanResult plan = plan_path(near, start, speed);
     ASSERT_TRUE(plan.ok()) << name << ": " << plan.reason;
@@ -463,9 +469,7 @@ TEST(PathPlannerTracks, PartialMapRacesAsFarAsItIsKnown) {
     const TrackFile t = read_track(name);
     const Boundaries b = boundaries(t);
     const Pose2 start = start_pose(t);
-    std::vector<Cone> near;
-    for (const Cone& c : t.cones)
-      if (distance(c.position, start.position()) <= seen) near.push_back(c);
+    const std::vector<Cone> near = cones_near(t.cones, start, seen);
     const PlanResult plan = plan_path(near, start, 3.0, racing);
     const PlanResult base = plan_path(near, start, 3.0, centre);
     ASSERT_TRUE(plan.ok() && base.ok()) << name << ": " << plan.reason << base.reason;

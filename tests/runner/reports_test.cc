@@ -6,11 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "sim/runner/files.h"
+#include "tests/runner/run_paddock.h"
 
 namespace paddock::runner {
 namespace {
@@ -46,12 +45,7 @@ TEST(Reports, SmoothingTableOnFsg2023) {
 
 TEST(Reports, ControllersTableRunsAllThree) {
   // the paper's stack, whose table it is
-  const auto d = std::filesystem::temp_directory_path() / "paddock_reports_test";
-  std::filesystem::create_directories(d);
-  const std::string scenario = (d / "fsg_2019_autocross_paper.ini").string();
-  std::ofstream(scenario) << "include = " << kRoot << "/scenarios/fsg_2019_autocross.ini\ninclude = " << kRoot
-                          << "/scenarios/paper.ini\n";
-  const std::string t = report_controllers(scenario, {});
+  const std::string t = report_controllers(testing::with_paper(kRoot + "/scenarios/fsg_2019_autocross.ini"), {});
   for (const char* row : {"| Combined |", "| Stanley |", "| Pure pursuit |"}) EXPECT_THAT(t, HasSubstr(row));
   EXPECT_THAT(t, HasSubstr("143.0 / 0.201 / 0.645 / 40.772"));
   // Stanley tracks tighter than pure pursuit (RMS), as in the paper

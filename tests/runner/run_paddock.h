@@ -4,6 +4,8 @@
 
 #include <array>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 namespace paddock::testing {
@@ -28,6 +30,16 @@ inline Outcome run_paddock_command(const std::string& command) {
 
 inline Outcome run_paddock(const std::string& args) {
   return run_paddock_command(std::string(PADDOCK_BINARY) + " " + args + " 2>&1");
+}
+
+// a shipped scenario with the paper's stack (scenarios/paper.ini after it),
+// written to the temporary directory: the path of that file
+inline std::string with_paper(const std::string& scenario) {
+  const std::filesystem::path d = std::filesystem::temp_directory_path() / "paddock_paper_scenarios";
+  std::filesystem::create_directories(d);
+  const std::filesystem::path f = d / std::filesystem::path(scenario).filename();
+  std::ofstream(f) << "include = " << scenario << "\ninclude = " << PADDOCK_SOURCE_DIR << "/scenarios/paper.ini\n";
+  return f.string();
 }
 
 }  // namespace paddock::testing

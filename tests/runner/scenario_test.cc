@@ -59,7 +59,9 @@ TEST(Scenario, DefaultLoadsWithTheVehicleFile) {
   EXPECT_EQ(s.vehicle.mass, 210.0);  // scenarios/vehicles/default.ini
   EXPECT_EQ(s.vehicle.accumulator_power_max, 80000.0);
   EXPECT_TRUE(fs::exists(s.track_path)) << s.track_path;
-  EXPECT_EQ(s.control.lateral, control::LateralMode::Combined);
+  // it races (racing.ini): the Stanley law on the car's envelope
+  EXPECT_EQ(s.control.lateral, control::LateralMode::Stanley);
+  EXPECT_EQ(s.planning.line, planning::PathPlannerParams::MinCurvature);
 }
 
 TEST_F(ScenarioFile, UnknownKeyNamesFileLineAndTheKnownKeys) {

@@ -13,6 +13,7 @@
 #include "sim/runner/sim_hal.h"
 #include "sim/runner/simulation.h"
 #include "sim/sensors/lidar.h"
+#include "tests/runner/run_paddock.h"
 
 namespace paddock::runner {
 namespace {
@@ -255,7 +256,9 @@ TEST(Simulation, WithTheGraphTheLoopClosesAndTheMapImproves) {
   // car back at the start closes the loop once, the graph's optimisation
   // re-anchors the filter, and the final map is nearer the true cones than
   // the front end's own (measured: 0.046 m -> 0.024 m)
-  Scenario s = load_scenario(kRoot + "/scenarios/fsg_2023_autocross.ini", {"autonomy.perception=ground_truth"});
+  // (the paper's stack: the SLAM figures were measured at its speeds)
+  Scenario s = load_scenario(testing::with_paper(kRoot + "/scenarios/fsg_2023_autocross.ini"),
+                             {"autonomy.perception=ground_truth"});
   const world::TrackModel track = world::build_track(load_track_file(s.track_path));
   s.autonomy.slam = stack::SlamMode::FastSlam;
   const RunResult front = run(s, track);
@@ -282,7 +285,9 @@ struct KidnapRun {
   bool dnf = false;
 };
 KidnapRun kidnap_run(bool kidnap) {
-  Scenario s = load_scenario(kRoot + "/scenarios/fsg_2023_autocross.ini", {"autonomy.perception=ground_truth"});
+  // the paper's stack: the kidnap's times are set on its lap
+  Scenario s = load_scenario(testing::with_paper(kRoot + "/scenarios/fsg_2023_autocross.ini"),
+                             {"autonomy.perception=ground_truth"});
   s.autonomy.slam = stack::SlamMode::FastSlamGraph;
   const world::TrackModel track = world::build_track(load_track_file(s.track_path));
   const SimModel model = compile_model(s, track);

@@ -46,10 +46,7 @@ struct Plain {
   bool finished = false;
 };
 Plain plain_run(const std::string& sets, const std::string& name) {
-  const std::string scenario = scratch(name) + ".ini";
-  std::ofstream(scenario) << "include = " << kRoot << "/scenarios/fsg_2023_autocross.ini\ninclude = " << kRoot
-                          << "/scenarios/paper.ini\n";
-  const auto o = testing::run_paddock("run " + scenario +
+  const auto o = testing::run_paddock("run " + testing::with_paper(kRoot + "/scenarios/fsg_2023_autocross.ini") +
                                       " --set autonomy.planner=oracle "
                                       "--set autonomy.perception=ground_truth --set autonomy.slam=ground_truth " +
                                       sets + " --json --out " + scratch(name));
