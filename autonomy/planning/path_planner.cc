@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "autonomy/common/line_fit.h"
@@ -70,6 +71,37 @@ void path_boundaries(const std::vector<Vec2>& path, bool closed, const std::vect
   for (const auto& [s, q] : r) right.push_back(q);
 }
 
+// the minimum-curvature line along out.smoothed (closed as out is) inside
+// the boundaries of the cones along it, as a trajectory with `reference`'s
+// profile: its points in out.racing_line and its boundaries in out, or
+// nothing, with out.racing_fallback saying why. An open line is held at the
+// car (leaving along start_heading) and at the end of the seen track
+std::optional<Trajectory> racing_trajectory(PlanResult& out, const std::vector<Cone>& cones,
+                                            const PathPlannerParams& params, const ReferenceParams& reference,
+                                            std::optional<double> v_start = std::nullopt,
+                                            std::optional<double> v_end = std::nullopt,
+                                            std::optional<double> start_heading = std::nullopt) {
+  path_boundaries(out.smoothed, out.closed, cones, out.triangulation, out.left_boundary, out.right_boundary);
+  const RacingLine line = min_curvature_line(out.smoothed, out.left_boundary, out.right_boundary, out.closed,
+                                             params.racing, !out.closed, start_heading);
+  if (!line.ok()) {
+    out.racing_fallback = line.reason;
+    return std::nullopt;
+  }
+  const SplineFit fit = fit_spline(line.points, out.closed);
+  if (!fit.ok()) {
+    out.racing_fallback = "racing line: " + fit.reason;
+    return std::nullopt;
+  }
+  ReferenceResult racing = reference_from_spline(fit.spline, reference, v_start, v_end);
+  if (!racing.ok()) {
+    out.racing_fallback = "racing line: " + racing.reason;
+    return std::nullopt;
+  }
+  out.racing_line = line.points;
+  return std::move(racing.trajectory);
+}
+
 }  // namespace
 
 bool plan_racing_line(PlanResult& out, const std::vector<Cone>& cones, const PathPlannerParams& params) {
@@ -81,24 +113,9 @@ bool plan_racing_line(PlanResult& out, const std::vector<Cone>& cones, const Pat
     out.racing_fallback = "racing line: not a planned lap";
     return false;
   }
-  path_boundaries(out.smoothed, true, cones, out.triangulation, out.left_boundary, out.right_boundary);
-  const RacingLine line = min_curvature_line(out.smoothed, out.left_boundary, out.right_boundary, true, params.racing);
-  if (!line.ok()) {
-    out.racing_fallback = line.reason;
-    return false;
-  }
-  const SplineFit fit = fit_spline(line.points, true);
-  if (!fit.ok()) {
-    out.racing_fallback = "racing line: " + fit.reason;
-    return false;
-  }
-  ReferenceResult racing = reference_from_spline(fit.spline, params.reference);
-  if (!racing.ok()) {
-    out.racing_fallback = "racing line: " + racing.reason;
-    return false;
-  }
-  out.racing_line = line.points;
-  out.trajectory = std::move(racing.trajectory);
+  std::optional<Trajectory> racing = racing_trajectory(out, cones, params, params.reference);
+  if (!racing) return false;
+  out.trajectory = std::move(*racing);
   return true;
 }
 
@@ -192,22 +209,8 @@ PlanResult plan_path(const std::vector<Cone>& cone_map, const Pose2& vehicle, do
   // car's heading) to where the seen track ends (back on the centreline
   // there); the centreline when it fails
   if (!out.closed && params.line == PathPlannerParams::MinCurvature) {
-    path_boundaries(out.smoothed, false, cone_map, out.triangulation, out.left_boundary, out.right_boundary);
-    const RacingLine line =
-        min_curvature_line(out.smoothed, out.left_boundary, out.right_boundary, false, params.racing, true, vehicle.yaw);
-    out.racing_fallback = line.reason;
-    if (line.ok()) {
-      const SplineFit fit = fit_spline(line.points, false);
-      out.racing_fallback = fit.ok() ? "" : "racing line: " + fit.reason;
-      if (fit.ok()) {
-        ReferenceResult racing = reference_from_spline(fit.spline, reference, v_start, v_end);
-        if (racing.ok()) {
-          out.racing_line = line.points;
-          return with_reference(std::move(out), std::move(racing));
-        }
-        out.racing_fallback = "racing line: " + racing.reason;
-      }
-    }
+    std::optional<Trajectory> racing = racing_trajectory(out, cone_map, params, reference, v_start, v_end, vehicle.yaw);
+    if (racing) return with_reference(std::move(out), ReferenceResult{std::move(*racing), ""});
   }
   ReferenceResult ref = build_reference(out.smoothed, out.closed, reference, v_start, v_end);
   // the spline can swing back towards a cone between the points: push the
