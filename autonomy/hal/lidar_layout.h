@@ -4,7 +4,9 @@
 // One struct for both sides of the HAL: the simulated sensor is built with it
 // (sensors::LidarParams embeds it) and the stack is told it as its
 // calibration (perception::LidarCalibration is this struct).
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "autonomy/common/geometry.h"
 #include "autonomy/common/params.h"
@@ -40,6 +42,28 @@ struct LidarLayout {
   // 1024 columns give a 6.1 mrad horizontal resolution
   int columns = 1024;
 
+  // what a sensor's metadata file adds (hal/ouster.h: layout_of); none of it
+  // is an INI key, and all of it empty or zero is the even fan above.
+  // the beams' elevations, one per channel, ascending (ring 0 the lowest);
+  // empty: evenly spaced from elevation_min to elevation_max
+  std::vector<double> beam_elevation;  // rad
+  // per channel, added to the column's azimuth (> 0 counter-clockwise);
+  // empty: none
+  std::vector<double> beam_azimuth;  // rad
+  // the beams leave the head beam_origin from the rotation axis, along the
+  // column's azimuth (Ouster's lidar_origin_to_beam_origin_mm)
+  double beam_origin = 0.0;  // m
+  // the head spins clockwise seen from above (an Ouster, a Velodyne): column c
+  // looks at pi - 2 pi c / columns; else counter-clockwise, at -pi + 2 pi c /
+  // columns. Both put column 0 behind the car (the seam where the car's body
+  // hides the view) and column columns / 2 straight ahead.
+  bool clockwise = false;
+  // the unit the sensor reports ranges in (an Ouster: 1 mm); 0: continuous
+  double range_resolution = 0.0;  // m
+  // the sensor reports intensity in [0, 1] in steps of 1 / intensity_full_scale
+  // (an Ouster's 16-bit signal field: 65535); 0: continuous
+  double intensity_full_scale = 0.0;
+
   template <class V>
   void visit(V& v) {
     v(PADDOCK_PARAM(mount_x), {"m", params::in(-10.0, 10.0), "the optical centre ahead of the rear axle"});
@@ -53,8 +77,81 @@ struct LidarLayout {
   }
   std::string check() const {
     const bool ordered = channels > 1 ? elevation_max > elevation_min : elevation_max >= elevation_min;
-    return ordered ? "" : "elevation_max must be > elevation_min (>= with one channel)";
+    if (!ordered) return "elevation_max must be > elevation_min (>= with one channel)";
+    const auto n = static_cast<std::size_t>(channels);
+    if (!beam_elevation.empty()) {
+      if (beam_elevation.size() != n) return "beam_elevation must have one entry per channel";
+      for (std::size_t i = 0; i < n; ++i) {
+        if (!std::isfinite(beam_elevation[i]) || (i > 0 && !(beam_elevation[i] > beam_elevation[i - 1])))
+          return "beam_elevation must be finite and strictly ascending";
+      }
+      if (beam_elevation.front() != elevation_min || beam_elevation.back() != elevation_max)
+        return "beam_elevation must run from elevation_min to elevation_max";
+    }
+    if (!beam_azimuth.empty() && beam_azimuth.size() != n) return "beam_azimuth must have one entry per channel";
+    for (const double a : beam_azimuth) {
+      if (!std::isfinite(a)) return "beam_azimuth must be finite";
+    }
+    if (!std::isfinite(beam_origin) || std::abs(beam_origin) > 1.0) return "beam_origin must be in [-1, 1] m";
+    if (!std::isfinite(range_resolution) || range_resolution < 0.0 || range_resolution > 1.0)
+      return "range_resolution must be in [0, 1] m";
+    if (!std::isfinite(intensity_full_scale) || intensity_full_scale < 0.0 || intensity_full_scale > 4294967295.0)
+      return "intensity_full_scale must be in [0, 2^32 - 1]";
+    return "";
   }
 };
+
+// the elevation of ring j (rad): beam_elevation[j], or the even fan's
+inline double ring_elevation(const LidarLayout& l, int j) {
+  if (!l.beam_elevation.empty()) return l.beam_elevation[static_cast<std::size_t>(j)];
+  const double res = l.channels > 1 ? (l.elevation_max - l.elevation_min) / (l.channels - 1) : 0.0;
+  return l.elevation_min + static_cast<double>(j) * res;
+}
+
+// the azimuth (rad, sensor frame, before beam_azimuth) of the head when it
+// has turned `turn` of a rotation (0 <= turn < 1) since the seam: the one
+// formula the simulated LiDAR casts along and the packet decoders use, so
+// that a column's angle agrees to the bit on both sides of the wire
+inline double turn_azimuth(const LidarLayout& l, double turn) {
+  return l.clockwise ? kPi - 2.0 * kPi * turn : -kPi + 2.0 * kPi * turn;
+}
+
+// the azimuth of column c: turn_azimuth at c / columns (counter-clockwise
+// written -pi + c (2 pi / columns), the simulator's formula before there was
+// a clockwise head; the same number when columns is a power of two)
+inline double column_azimuth(const LidarLayout& l, int c) {
+  if (!l.clockwise) return -kPi + static_cast<double>(c) * (2.0 * kPi / l.columns);
+  return turn_azimuth(l, static_cast<double>(c) / static_cast<double>(l.columns));
+}
+
+// the range a sensor reports for a measured range r (m): r rounded to
+// range_resolution (the nearest unit, halves away from zero), or r itself
+inline double reported_range(const LidarLayout& l, double r) {
+  return l.range_resolution > 0.0 ? std::round(r / l.range_resolution) * l.range_resolution : r;
+}
+
+// the intensity a sensor reports for i in [0, 1]: the nearest step of
+// 1 / intensity_full_scale (as the decoder's count / full scale), or i itself
+inline double reported_intensity(const LidarLayout& l, double i) {
+  return l.intensity_full_scale > 0.0 ? std::round(i * l.intensity_full_scale) / l.intensity_full_scale : i;
+}
+
+// the point (sensor frame) of a return at range r (m) on a beam of elevation
+// (cos ce, sin se) and azimuth (cos ca, sin sa), the head's column azimuth
+// (cos ca0, sin sa0): the beam leaves beam_origin n out along the column's
+// azimuth (Ouster, "Lidar Range to XYZ"). n = 0 is r * (ce ca, ce sa, se).
+inline void beam_point(double r, double n, double ce, double se, double ca, double sa, double ca0, double sa0,
+                       float p[3]) {
+  if (n == 0.0) {
+    p[0] = static_cast<float>(r * (ce * ca));
+    p[1] = static_cast<float>(r * (ce * sa));
+    p[2] = static_cast<float>(r * se);
+    return;
+  }
+  const double q = r - n;
+  p[0] = static_cast<float>(q * (ce * ca) + n * ca0);
+  p[1] = static_cast<float>(q * (ce * sa) + n * sa0);
+  p[2] = static_cast<float>(q * se);
+}
 
 }  // namespace paddock::hal

@@ -87,15 +87,25 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
     if (d.ok) hal.post(std::move(d.detections));
   }
   const std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [&poses](TimeNs t) { return poses.at(t); }, start);
+  truth_.resize(raw.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) truth_[i] = raw[i].cone;
+  if (const WireLink* wire = hal.wire(); wire != nullptr && wire->has_lidar()) {
+    // the sensor's packets, in the order it sends them (the car's decoder
+    // gives the points back in the scan's order: column by column, rings up)
+    column_time_.resize(static_cast<std::size_t>(lidar_.params().columns));
+    for (std::size_t c = 0; c < column_time_.size(); ++c) column_time_[c] = lidar_.column_time(start, static_cast<int>(c));
+    packets_.clear();
+    wire->encode_lidar(raw, column_time_, frame_id_++, packets_);
+    hal.post_lidar(packets_);
+    return truth_;
+  }
   hal::LidarScan scan;
   scan.stamp = start;
   scan.end = scan_end(now);
   scan.points.resize(raw.size());
-  truth_.resize(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) {
     const sensors::LidarPoint& p = raw[i];
     scan.points[i] = hal::LidarPoint{p.x, p.y, p.z, p.intensity, p.ring, p.t};
-    truth_[i] = p.cone;
   }
   hal.post(std::move(scan));
   return truth_;

@@ -85,6 +85,11 @@ class RawSensors {
   std::vector<Cone> scene_cones_;
   std::vector<bool> scene_knocked_;
   std::vector<std::int32_t> truth_;
+  // transport = wire: the rotation counter (the packets' frame_id), the
+  // columns' times, the packets (kept to save their allocations)
+  std::uint16_t frame_id_ = 0;
+  std::vector<TimeNs> column_time_;
+  std::vector<std::uint8_t> packets_;
 };
 
 }  // namespace paddock::runner

@@ -7,7 +7,10 @@
 #include <functional>
 #include <map>
 #include <set>
+#include <memory>
 #include <sstream>
+#include <stdexcept>
+#include <tuple>
 #include <utility>
 
 #include "sim/runner/files.h"
@@ -109,14 +112,25 @@ IniEntry override_entry(const std::string& o, int number) {
   return {trim(o.substr(0, dot)), trim(o.substr(dot + 1, eq - dot - 1)), trim(o.substr(eq + 1)), "--set", number};
 }
 
-// the track file named by `e`, relative to the file it was written in
-void resolve_track(Scenario& s, const IniEntry& e) {
-  if (e.value.empty()) throw UserError(e.where() + ": [scenario] track needs a file name");
+// the file named by `e`, relative to the file it was written in (as given,
+// and absolute)
+std::pair<std::string, std::string> resolve_file(const IniEntry& e) {
   namespace fs = std::filesystem;
   const fs::path p(e.value);
   const fs::path base = e.file == "--set" ? fs::path() : fs::path(e.file).parent_path();
-  s.track_path = (p.is_absolute() ? p : (base / p)).lexically_normal().string();
-  s.scenario.track = fs::absolute(s.track_path).lexically_normal().string();
+  const std::string path = (p.is_absolute() ? p : (base / p)).lexically_normal().string();
+  return {path, fs::absolute(path).lexically_normal().string()};
+}
+
+// the track file named by `e`
+void resolve_track(Scenario& s, const IniEntry& e) {
+  if (e.value.empty()) throw UserError(e.where() + ": [scenario] track needs a file name");
+  std::tie(s.track_path, s.scenario.track) = resolve_file(e);
+}
+
+// a [hal] file named by `e` (empty: none), written absolute
+void resolve_hal_file(std::string& field, const IniEntry& e) {
+  if (!e.value.empty()) field = resolve_file(e).second;
 }
 
 using Given = std::set<std::pair<std::string, std::string>>;
@@ -165,15 +179,69 @@ void require_given(const std::vector<Key>& keys, const Given& given, const std::
   }
 }
 
+// the [hal] files: the LiDAR's metadata sets its layout (a [lidar] key it
+// sets may be given only with the file's value), the DBC is parsed and
+// checked against what the car sends; wire needs both where they are used
+void load_hal_files(Scenario& s, const std::vector<IniEntry>& entries, const std::string& path) {
+  if (!s.hal.lidar_metadata.empty()) {
+    const std::string& file = s.hal.lidar_metadata;
+    try {
+      s.lidar_info = hal::ouster::parse_sensor_info(read_file(file), file);
+    } catch (const std::invalid_argument& e) {
+      throw UserError(e.what());
+    }
+    sensors::LidarParams& l = s.lidar;
+    const sensors::LidarParams keys = l;
+    static_cast<hal::LidarLayout&>(l) = hal::ouster::layout_of(*s.lidar_info, l);
+    l.rate = s.lidar_info->frequency;
+    // the keys the file sets: one given must have the file's value (the
+    // resolved scenario writes them so)
+    const std::tuple<const char*, double, double> from_file[] = {
+        {"channels", keys.channels, l.channels},
+        {"columns", keys.columns, l.columns},
+        {"elevation_min", keys.elevation_min, l.elevation_min},
+        {"elevation_max", keys.elevation_max, l.elevation_max},
+        {"rate", keys.rate, l.rate}};
+    for (const auto& [key, given, value] : from_file) {
+      const auto it = std::find_if(entries.rbegin(), entries.rend(),
+                                   [key = key](const IniEntry& e) { return e.section == "lidar" && e.key == key; });
+      if (it == entries.rend() || std::abs(given - value) <= 1e-12 * std::max(1.0, std::abs(value))) continue;
+      throw UserError(it->where() + ": [lidar] " + key + " = " + it->value + " contradicts the metadata file " + file +
+                      " ([hal] lidar_metadata), which sets it to " + params::number(value) +
+                      "; expected that value or no key");
+    }
+  }
+  if (!s.hal.dbc.empty()) {
+    const std::string& file = s.hal.dbc;
+    try {
+      s.dbc = std::make_shared<const hal::Dbc>(hal::parse_dbc(read_file(file), file));
+      // the car's frames must all be there (throws naming what is missing)
+      const hal::CarCan check(*s.dbc, file);
+    } catch (const std::invalid_argument& e) {
+      throw UserError(e.what());
+    }
+  }
+  if (s.hal.transport == Transport::Wire) {
+    const bool lidar = s.autonomy.perception != stack::PerceptionMode::GroundTruth;
+    if (lidar && s.hal.lidar_metadata.empty())
+      throw UserError(path + ": [hal] transport = wire sends the LiDAR's packets: [hal] lidar_metadata must name its metadata file");
+    if (s.hal.dbc.empty())
+      throw UserError(path + ": [hal] transport = wire sends the car's CAN frames: [hal] dbc must name the car's DBC file");
+  }
+}
+
 // sets every entry's key; unknown sections and keys, and required keys left
 // unset, are errors
 void apply_entries(Scenario& s, const std::vector<IniEntry>& entries, const std::string& path) {
   std::vector<Key> keys = scenario_keys(s);
   const Given given = set_keys(keys, entries, [&s](const Key& k, const IniEntry& e) {
     if (k.path() == "scenario.track") resolve_track(s, e);
+    if (k.path() == "hal.lidar_metadata") resolve_hal_file(s.hal.lidar_metadata, e);
+    if (k.path() == "hal.dbc") resolve_hal_file(s.hal.dbc, e);
   });
   require_given(keys, given, path, "; include a vehicle file, e.g. include = vehicles/default.ini");
   if (s.track_path.empty()) throw UserError(path + ": [scenario] track is not set; expected the track's CSV file");
+  load_hal_files(s, entries, path);
 }
 
 // a problem from params::validate ("a.b.key must be ...") as "[a.b] key must be ..."

@@ -3,11 +3,15 @@
 // program, with every default filled in and an explicit seed. Nothing inside
 // sim/ or autonomy/ reads files; they get pieces of this.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "autonomy/hal/car_can.h"
+#include "autonomy/hal/dbc.h"
+#include "autonomy/hal/ouster.h"
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
 #include "sim/sensors/annotation_detector.h"
@@ -46,6 +50,34 @@ struct ScenarioSection {
     v(PADDOCK_PARAM(event), kEvents, "the FS event and its rules");
     v(PADDOCK_PARAM(seed), {"", params::in(0, 9.2e18), "the run's random seed (every random draw derives from it)"});
     v(PADDOCK_PARAM(go_time), {"s", params::in(0.0, 600.0), "time in AS Ready before the go signal"});
+  }
+};
+
+// [hal]: what crosses the HAL, and how
+enum class Transport {
+  // the sensor messages as the stack's structs
+  Memory,
+  // every sensor message the car's hardware sends on a wire is encoded into
+  // its wire format (the LiDAR's UDP packets, CAN frames) and decoded by the
+  // car's own decoders, as on the car; the actuator command goes back as a
+  // CAN frame
+  Wire,
+};
+
+struct HalSection {
+  Transport transport = Transport::Memory;
+  // files relative to the file that names them; the resolved scenario writes
+  // them absolute. Empty: none.
+  std::string lidar_metadata;
+  std::string dbc;
+
+  static constexpr params::Choice<Transport> kTransports[] = {{"memory", Transport::Memory},
+                                                              {"wire", Transport::Wire}};
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(transport), kTransports, "memory: the messages as structs; wire: through their wire formats and the car's decoders");
+    v(PADDOCK_PARAM(lidar_metadata), "the LiDAR's metadata file (Ouster sensor_info JSON): the layout the simulated LiDAR casts and the decoder reads");
+    v(PADDOCK_PARAM(dbc), "the car's CAN database (DBC): the frames of the IMU, wheel speeds, steering, RES and commands");
   }
 };
 
@@ -114,8 +146,13 @@ struct Scenario {
   std::string name;        // its stem
   std::string track_path;  // [scenario] track resolved against the naming file's folder
 
+  // what the [hal] files say, read and checked at load (none when unnamed)
+  std::optional<hal::ouster::SensorInfo> lidar_info;
+  std::shared_ptr<const hal::Dbc> dbc;
+
   ScenarioSection scenario;
   stack::AutonomyModes autonomy;
+  HalSection hal;
   // the car and the world
   vehicle::VehicleParams vehicle;
   world::ConeWorldParams cones;
@@ -148,6 +185,7 @@ struct Scenario {
   void visit(V& v) {
     v.section(PADDOCK_PARAM(scenario), "the event, its track and the run's seed");
     v.section(PADDOCK_PARAM(autonomy), "where each layer of the stack gets its input: the real module or ground truth");
+    v.section(PADDOCK_PARAM(hal), "the HAL between the simulator and the stack: transport and the sensors' wire descriptions");
     v.section(PADDOCK_PARAM(vehicle), "every physical parameter of the car, all required: include = vehicles/default.ini");
     v.section(PADDOCK_PARAM(cones), "the cones' physics (Box2D): masses, knock-over impulses, frictions");
     v.section(PADDOCK_PARAM(ground), "the ground the sensors see (the vehicle model stays planar)");

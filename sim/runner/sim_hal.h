@@ -1,13 +1,17 @@
 #pragma once
 // the simulator's back end of the HAL: the runner posts sensor messages, the
 // stack drains them and leaves its command here for the actuators.
+#include <cstdint>
 #include <deque>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <utility>
 #include <variant>
+#include <vector>
 
 #include "autonomy/hal/hal.h"
+#include "sim/runner/wire.h"
 
 namespace paddock::runner {
 
@@ -16,26 +20,44 @@ class SimHal final : public hal::Hal {
   // true_state: whether the simulator may hand the stack its true state
   // (slam = ground_truth); otherwise posting a hal::StateEstimate is a bug
   // in the simulator and throws, so the truth can never reach the stack
-  // unnoticed
-  explicit SimHal(bool true_state = true) : true_state_(true_state) {}
+  // unnoticed. wire: transport = wire (what the car sends on its wires goes
+  // through them), or none (transport = memory)
+  explicit SimHal(bool true_state = true, std::unique_ptr<WireLink> wire = nullptr)
+      : true_state_(true_state), wire_(std::move(wire)) {}
   void post(hal::SensorMessage m) {
     if (!true_state_ && std::holds_alternative<hal::StateEstimate>(m))
       throw std::logic_error("the true state may not cross the HAL: the stack estimates its own (slam != ground_truth)");
+    if (wire_ && WireLink::on_can(m)) return wire_->carry(m, inbox_);
+    if (wire_ && wire_->has_lidar() && std::holds_alternative<hal::LidarScan>(m))
+      throw std::logic_error("transport = wire: the LiDAR's scans cross the HAL as its packets (post_lidar)");
     inbox_.push_back(std::move(m));
   }
+  // transport = wire: one LiDAR rotation's packets, decoded by the car's decoder
+  void post_lidar(const std::vector<std::uint8_t>& packets) { wire_->carry_lidar(packets, inbox_); }
   bool true_state() const { return true_state_; }
+  // the wire, when transport = wire
+  WireLink* wire() const { return wire_.get(); }
   std::optional<hal::SensorMessage> receive() override {
     if (inbox_.empty()) return std::nullopt;
     hal::SensorMessage m = std::move(inbox_.front());
     inbox_.pop_front();
     return m;
   }
-  void send(const hal::ActuatorCommand& c) override { command_ = c; }
+  // the command as the actuators take it: with the wire, what the car's VCU
+  // decoded from the stack's frame (a frame it dropped leaves the last one)
+  void send(const hal::ActuatorCommand& c) override {
+    if (!wire_) {
+      command_ = c;
+    } else if (std::optional<hal::ActuatorCommand> d = wire_->carry(c)) {
+      command_ = *d;
+    }
+  }
   // the last command sent, if any
   const std::optional<hal::ActuatorCommand>& command() const { return command_; }
 
  private:
   bool true_state_ = true;
+  std::unique_ptr<WireLink> wire_;
   std::deque<hal::SensorMessage> inbox_;
   std::optional<hal::ActuatorCommand> command_;
 };

@@ -163,6 +163,13 @@ RunResult results_of(const SimState& s) {
   return r;
 }
 
+// transport = wire: the car's wires (the LiDAR's only when the stack reads it)
+std::unique_ptr<WireLink> make_wire(const Scenario& sc) {
+  if (sc.hal.transport != Transport::Wire) return nullptr;
+  const bool lidar = sc.autonomy.perception != stack::PerceptionMode::GroundTruth;
+  return std::make_unique<WireLink>(lidar ? sc.lidar_info : std::nullopt, sc.lidar, *sc.dbc, sc.hal.dbc);
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -175,7 +182,7 @@ SimState::SimState(const SimModel& model)
             world::Footprint{-model.footprint.x_min, model.footprint.x_max, model.footprint.y_max}),
       event(model.scenario.scenario.event, model.track, model.scenario.event),
       stack(model.stack, model.mission),
-      hal(model.stack.autonomy.slam == stack::SlamMode::GroundTruth),
+      hal(model.stack.autonomy.slam == stack::SlamMode::GroundTruth, make_wire(model.scenario)),
       cone_sensor(model.cone_sensor, stream_seed(model.scenario.scenario.seed, "cone_sensor")),
       cones_now(model.cones.size()),
       cones_knocked(model.cones.size()),

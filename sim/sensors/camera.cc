@@ -42,7 +42,9 @@ constexpr int kGroundTile = 4;          // px, non-flat ground outside the boxes
 int trigger_column(const LidarParams& lidar, double azimuth) {
   const int n = std::max(lidar.columns, 1);
   const double a = wrap_angle(azimuth);  // [-pi, pi)
-  const long c = std::lround((a + kPi) * n / (2.0 * kPi));
+  // the turn since the seam at which the head looks there (hal::column_azimuth)
+  const double turn = lidar.clockwise ? kPi - a : a + kPi;
+  const long c = std::lround(turn * n / (2.0 * kPi));
   return static_cast<int>(((c % n) + n) % n);
 }
 

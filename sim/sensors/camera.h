@@ -191,7 +191,8 @@ struct AnnotatedFrame {
 
 // the LiDAR column nearest to azimuth (rad, lidar frame): column c looks at
 // -pi + 2 pi c / columns (lidar.h), so c = round((azimuth + pi) columns / 2 pi)
-// mod columns
+// mod columns; a clockwise head's at pi - 2 pi c / columns, so
+// c = round((pi - azimuth) columns / 2 pi) mod columns
 int trigger_column(const LidarParams& lidar, double azimuth);
 // when a LiDAR rotation starting at scan_start fires that column (as
 // Lidar::column_time: scan_start + period c / columns, period = 1 / rate in

@@ -544,17 +544,26 @@ Lidar::Lidar(const LidarParams& params, std::uint64_t seed) : params_(params), r
   sin_pitch_ = std::sin(params_.mount_pitch);
   const auto nch = static_cast<std::size_t>(params_.channels);
   const auto ncol = static_cast<std::size_t>(params_.columns);
+  // every channel of a column is cast in one vertical half-plane from the
+  // rotation axis (find_windows relies on it): no per-beam azimuth offsets,
+  // no beam origin off the axis (hal::LidarLayout; a metadata file that has
+  // them can be decoded but not simulated)
+  for (const double a : params_.beam_azimuth) {
+    if (a != 0.0) throw std::invalid_argument("LidarParams: the simulated LiDAR casts every channel of a column at its azimuth: beam_azimuth must be 0");
+  }
+  if (params_.beam_origin != 0.0)
+    throw std::invalid_argument("LidarParams: the simulated LiDAR casts from the rotation axis: beam_origin must be 0");
   cos_el_.resize(nch);
   sin_el_.resize(nch);
   for (std::size_t i = 0; i < nch; ++i) {
-    const double e = params_.elevation_min + static_cast<double>(i) * vertical_resolution();
+    const double e = hal::ring_elevation(params_, static_cast<int>(i));
     cos_el_[i] = std::cos(e);
     sin_el_[i] = std::sin(e);
   }
   cos_az_.resize(ncol);
   sin_az_.resize(ncol);
   for (std::size_t c = 0; c < ncol; ++c) {
-    const double a = -kPi + static_cast<double>(c) * horizontal_resolution();
+    const double a = hal::column_azimuth(params_, static_cast<int>(c));
     cos_az_[c] = std::cos(a);
     sin_az_[c] = std::sin(a);
   }
@@ -675,6 +684,7 @@ void Lidar::find_windows(const LidarWorld& world, float tfar) {
   const double cp = cos_pitch_, sp = sin_pitch_;
   const double el0 = params_.elevation_min, del = vertical_resolution();
   const double daz = horizontal_resolution();
+  const double spin = params_.clockwise ? -1.0 : 1.0;
   const double reach = static_cast<double>(tfar);
   const auto pose = [this](int c) -> const ColumnPose& {
     return poses_[static_cast<std::size_t>(c)];
@@ -750,6 +760,13 @@ void Lidar::find_windows(const LidarWorld& world, float tfar) {
       const double elo = std::atan(lo_t), ehi = std::atan(hi_t);
       if (nch == 1) {
         if (el0 < elo || el0 > ehi) return;
+      } else if (!params_.beam_elevation.empty()) {
+        // a metadata file's elevations: the rings within [elo, ehi], a
+        // little wider
+        const std::vector<double>& el = params_.beam_elevation;
+        const double tol = 1e-9 * std::max(1.0, std::abs(el.back() - el.front()));
+        lo = static_cast<int>(std::lower_bound(el.begin(), el.end(), elo - tol) - el.begin());
+        hi = static_cast<int>(std::upper_bound(el.begin(), el.end(), ehi + tol) - el.begin()) - 1;
       } else {
         const double flo = std::clamp((elo - el0) / del, -2.0, nch + 1.0);
         const double fhi = std::clamp((ehi - el0) / del, -2.0, nch + 1.0);
@@ -778,8 +795,11 @@ void Lidar::find_windows(const LidarWorld& world, float tfar) {
       // |R(yaw_c) - R(yaw_ref)| = 2 |sin((yaw_c - yaw_ref) / 2)|, the chord
       Y = std::max(Y, std::hypot(pose(c).cy - qr.cy, pose(c).sy - qr.sy));
     }
-    // the wedge's edges' normals: n_a . x >= 0 and n_b . x <= 0 inside
-    const auto ua = static_cast<std::size_t>(c0), ub = static_cast<std::size_t>(c1 - 1);
+    // the wedge's edges' normals: n_a . x >= 0 and n_b . x <= 0 inside (a
+    // clockwise head sweeps the chunk from its last column's azimuth to its
+    // first's, counter-clockwise)
+    auto ua = static_cast<std::size_t>(c0), ub = static_cast<std::size_t>(c1 - 1);
+    if (params_.clockwise) std::swap(ua, ub);
     const double na[2] = {-sin_az_[ua], cos_az_[ua]}, nb[2] = {-sin_az_[ub], cos_az_[ub]};
     for (const int k : near_) {
       const LidarWorld::Bounds& b = bounds[static_cast<std::size_t>(k)];
@@ -798,7 +818,9 @@ void Lidar::find_windows(const LidarWorld& world, float tfar) {
         }
         continue;
       }
-      const double phi = std::atan2(s[1], s[0]), beta = std::asin(R / rho);
+      // column c looks at -pi + c daz, or (clockwise) pi - c daz: the mirror
+      // image, so a clockwise head finds its columns at the mirrored azimuth
+      const double phi = spin * std::atan2(s[1], s[0]), beta = std::asin(R / rho);
       const double a0 = (phi - beta + kPi) / daz - 1.0, a1 = (phi + beta + kPi) / daz + 1.0;
       // (a1 - a0 < ncol / 4: the window meets the chunk once, maybe a turn away)
       for (const double turn : {-1.0, 0.0, 1.0}) {
@@ -863,6 +885,7 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
   const bool noisy = params_.range_noise > 0.0;
   const bool drops = params_.dropout > 0.0;
   const bool inoisy = params_.intensity_noise > 0.0;
+  const bool quantised = params_.range_resolution > 0.0 || params_.intensity_full_scale > 0.0;
   const double range_noise = params_.range_noise, intensity_noise = params_.intensity_noise;
   const double range_min = params_.range_min, range_max = params_.range_max;
   const double cp = cos_pitch_, sp = sin_pitch_;
@@ -1065,11 +1088,14 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
       if (drops && uniform_(rng_) < params_.dropout) continue;
       double r = b.range[j];
       if (noisy) r += range_noise * draw();
+      // as the sensor reports it (its range unit, hal::reported_range)
+      if (quantised) r = hal::reported_range(params_, r);
       if (r < range_min || r > range_max) continue;
       double intensity = b.bright[j];
       if (inoisy) intensity += intensity_noise * draw();
       // clamped to [0, 1] (std::clamp's result, without its branches)
       intensity = std::min(std::max(intensity, 0.0), 1.0);
+      if (quantised) intensity = hal::reported_intensity(params_, intensity);
       // the direction in the sensor frame as beam_dir's
       const double ce = cos_el_[j];
       dst->x = static_cast<float>(r * (ce * ca));
@@ -1077,6 +1103,7 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
       dst->z = static_cast<float>(r * sin_el_[j]);
       dst->intensity = static_cast<float>(intensity);
       dst->ring = static_cast<std::uint16_t>(j);
+      dst->column = static_cast<std::uint16_t>(c);
       dst->t = q.t;
       dst->cone = b.cone[j];
       ++dst;

@@ -12,10 +12,14 @@
 // The sensor frame `lidar`: origin at the optical centre, x forward, y left,
 // z up (REP-103), mounted in the base frame at (mount_x, mount_y, mount_z) with
 // the yaw of the base and a pitch mount_pitch about its y axis (> 0 tilts the
-// nose down). The head spins counter-clockwise seen from above; column c looks
-// at azimuth -pi + 2 pi c / columns in the sensor frame (column 0 looks
-// backwards, column columns/2 straight ahead, so the seam of a rotation lies
-// behind the car, where its body hides the view anyway).
+// nose down). The head spins counter-clockwise seen from above, column c
+// looking at azimuth -pi + 2 pi c / columns in the sensor frame, or, with
+// `clockwise` (an Ouster's metadata file), at pi - 2 pi c / columns (column 0
+// looks backwards, column columns/2 straight ahead, so the seam of a rotation
+// lies behind the car, where its body hides the view anyway). The channels'
+// elevations are the layout's (hal::ring_elevation: an even fan, or a metadata
+// file's beams); ranges and intensities are reported in the sensor's units
+// when the layout has them (range_resolution, intensity_full_scale).
 //
 // Intensity: a material model. Each hit has a material (ConeMaterial: the cone's
 // stripes by height along its axis, or the asphalt ground) with a reflectivity
@@ -318,6 +322,7 @@ struct LidarPoint {
   float x, y, z;        // m, sensor frame at the point's own time (x forward, y left, z up)
   float intensity;      // -, [0, 1]; the material model (see the top)
   std::uint16_t ring;   // channel, 0 = lowest elevation
+  std::uint16_t column;  // the column (firing) of the rotation, 0 = the first
   std::int64_t t;       // ns, the time of the point's column
   std::int32_t cone;    // ground truth: cone index hit, kHitGround, kHitStructure
 };

@@ -19,6 +19,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -170,11 +171,28 @@ struct Case {
   double pitch;  // rad
   bool noise;
   bool blocks = false;
+  // a clockwise head (an Ouster's) with an uneven fan of beams, denser at
+  // the horizon, reporting ranges in mm and intensities in 16-bit steps
+  bool ouster = false;
 };
+
+// the uneven fan: -15 .. +15 deg, the spacing growing away from the horizon
+void ouster_layout(LidarParams& p) {
+  p.clockwise = true;
+  p.beam_elevation.clear();
+  for (int i = 0; i < p.channels; ++i) {
+    const double u = -1.0 + 2.0 * i / (p.channels - 1.0);  // [-1, 1]
+    p.beam_elevation.push_back(15.0 * kPi / 180.0 * u * std::abs(u) * 0.7 + 15.0 * kPi / 180.0 * u * 0.3);
+  }
+  p.elevation_min = p.beam_elevation.front();
+  p.elevation_max = p.beam_elevation.back();
+  p.range_resolution = 0.001;
+  p.intensity_full_scale = 65535.0;
+}
 
 void PrintTo(const Case& k, std::ostream* os) {
   *os << k.ground << (k.moving ? " moving" : " still") << " pitch " << k.pitch
-      << (k.noise ? " noisy" : "") << (k.blocks ? " blocks" : "");
+      << (k.noise ? " noisy" : "") << (k.blocks ? " blocks" : "") << (k.ouster ? " ouster" : "");
 }
 
 class LidarCastSame : public ::testing::TestWithParam<Case> {};
@@ -192,10 +210,11 @@ TEST_P(LidarCastSame, ExploitMatchesTheWholeScenePointByPoint) {
     p.range_noise = 0.0;
     p.intensity_noise = 0.0;
   }
+  if (k.ouster) ouster_layout(p);
   const auto traj = trajectory(k.moving);
   const std::string what = k.ground + (k.moving ? " moving" : " at rest") +
                            (k.pitch != 0.0 ? " pitched" : "") + (k.noise ? " noisy" : "") +
-                           (k.blocks ? " blocks" : "");
+                           (k.blocks ? " blocks" : "") + (k.ouster ? " ouster" : "");
   const TimeNs start = from_seconds(0.3);
   // three scans in a row from each sensor: the streams must stay in step
   Lidar fast(p, 77), single(p, 77), packets(p, 77);
@@ -249,12 +268,118 @@ INSTANTIATE_TEST_SUITE_P(
                       Case{"flat", true, 0.06, true}, Case{"sloped", true, 0.0, true},
                       Case{"bumpy", true, 0.0, true}, Case{"sloped_bumpy", false, 0.0, false},
                       Case{"sloped_bumpy", true, -0.04, true}, Case{"flat", false, 0.0, false, true},
-                      Case{"flat", true, 0.06, true, true}, Case{"sloped_bumpy", true, 0.0, true, true}),
+                      Case{"flat", true, 0.06, true, true}, Case{"sloped_bumpy", true, 0.0, true, true},
+                      Case{"flat", true, 0.0, true, false, true}, Case{"flat", true, 0.06, true, true, true},
+                      Case{"sloped", true, 0.0, true, false, true}),
     [](const ::testing::TestParamInfo<Case>& i) {
       return i.param.ground + (i.param.moving ? "_moving" : "_still") +
              (i.param.pitch != 0.0 ? "_pitched" : "") + (i.param.noise ? "_noisy" : "") +
-             (i.param.blocks ? "_blocks" : "");
+             (i.param.blocks ? "_blocks" : "") + (i.param.ouster ? "_ouster" : "");
     });
+
+// a clockwise head with the layout's own beams: each point lies on its beam
+// (column c at pi - 2 pi c / columns, ring j at beam_elevation[j]), is fired at
+// its column's time, reports its range in whole mm and its intensity in
+// 16-bit steps; and a head standing still sees the mirror image of what the
+// counter-clockwise head sees in the mirrored world, column by column (column
+// c of one looks at the mirror image of column c's azimuth of the other)
+TEST(LidarSpin, ClockwiseHeadFiresItsColumnsClockwise) {
+  const Scene s = make_scene(false);
+  Scene mirror = s;
+  for (Cone& c : mirror.cones) c.position.y = -c.position.y;
+  LidarWorld world(s.cones, s.knocked, ground("flat"));
+  LidarWorld mirrored(mirror.cones, mirror.knocked, ground("flat"));
+  LidarParams p;
+  p.range_noise = 0.0;
+  p.intensity_noise = 0.0;
+  LidarParams cw = p;
+  cw.clockwise = true;
+  const auto still = trajectory(false);
+  const TimeNs start = from_seconds(0.3);
+  Lidar ccw_lidar(p, 5), cw_lidar(cw, 5);
+  const auto a = cw_lidar.scan(world, still, start);
+  const auto b = ccw_lidar.scan(mirrored, still, start);
+  ASSERT_GT(a.size(), 10000u);
+  // on its beam, at its column's time
+  double worst = 0.0;
+  for (const LidarPoint& q : a) {
+    const double az = kPi - 2.0 * kPi * q.column / cw.columns;
+    const double el = cw.elevation_min + (cw.elevation_max - cw.elevation_min) * q.ring / (cw.channels - 1);
+    const double r = std::sqrt(double(q.x) * q.x + double(q.y) * q.y + double(q.z) * q.z);
+    worst = std::max({worst, std::abs(q.x - r * std::cos(el) * std::cos(az)),
+                      std::abs(q.y - r * std::cos(el) * std::sin(az)), std::abs(q.z - r * std::sin(el))});
+    EXPECT_EQ(q.t, cw_lidar.column_time(start, q.column));
+  }
+  EXPECT_LT(worst, 1e-4);
+  // the mirror image, column by column
+  std::vector<std::vector<LidarPoint>> by_column(static_cast<std::size_t>(cw.columns));
+  for (const LidarPoint& q : b) by_column[q.column].push_back(q);
+  std::size_t matched = 0;
+  for (const LidarPoint& q : a) {
+    const auto& other = by_column[q.column];
+    for (const LidarPoint& o : other) {
+      if (o.ring != q.ring) continue;
+      EXPECT_NEAR(q.x, o.x, 1e-4);
+      EXPECT_NEAR(q.y, -o.y, 1e-4);
+      EXPECT_NEAR(q.z, o.z, 1e-4);
+      ++matched;
+    }
+  }
+  EXPECT_GT(matched, a.size() * 99 / 100);
+  EXPECT_LE(matched, a.size());
+  // the sensor's units
+  LidarParams units = cw;
+  ouster_layout(units);
+  units.range_noise = 0.02;
+  units.intensity_noise = 0.01;
+  Lidar unit_lidar(units, 5);
+  const auto c = unit_lidar.scan(world, trajectory(true), start);
+  ASSERT_GT(c.size(), 10000u);
+  for (const LidarPoint& q : c) {
+    const double r = std::sqrt(double(q.x) * q.x + double(q.y) * q.y + double(q.z) * q.z);
+    // (to float rounding of the coordinates: 0.006 mm at 50 m)
+    ASSERT_NEAR(r * 1000.0, std::round(r * 1000.0), 0.02) << "a range in whole mm";
+    ASSERT_NEAR(q.intensity * 65535.0, std::round(q.intensity * 65535.0), 1e-2) << "a 16-bit intensity";
+    ASSERT_NEAR(std::asin(q.z / r), units.beam_elevation[q.ring], 1e-5);
+  }
+}
+
+}  // namespace
+}  // namespace paddock::sensors
+
+namespace paddock::sensors {
+namespace {
+
+// a head spinning either way on a car that drives and turns: every point on
+// a standing cone, carried into the world from the pose at its own time, lies
+// on that cone (within its base radius of its axis, between the ground and
+// its top)
+TEST(LidarSpin, AMovingHeadsPointsLieOnWhatTheyHitEitherWay) {
+  const Scene s = make_scene(false);
+  LidarWorld world(s.cones, s.knocked, ground("flat"));
+  const auto traj = trajectory(true);
+  for (const bool cw : {false, true}) {
+    LidarParams p;
+    p.range_noise = 0.0;
+    p.intensity_noise = 0.0;
+    p.clockwise = cw;
+    Lidar lidar(p, 3);
+    const auto pts = lidar.scan(world, traj, from_seconds(0.3));
+    std::size_t on = 0;
+    double worst = 0.0;
+    for (const LidarPoint& q : pts) {
+      if (q.cone < 0 || s.knocked[static_cast<std::size_t>(q.cone)]) continue;
+      const Pose2 b = traj(q.t);
+      const Vec2 w = b.transform({p.mount_x + q.x, p.mount_y + q.y});
+      const Cone& c = s.cones[static_cast<std::size_t>(q.cone)];
+      const double base = c.color == ConeColor::BigOrange ? kBigConeBaseWidth / 2 : kSmallConeBaseWidth / 2;
+      worst = std::max(worst, distance(w, c.position) - base);
+      ++on;
+    }
+    EXPECT_GT(on, 500u) << (cw ? "clockwise" : "counter-clockwise");
+    EXPECT_LT(worst, 2e-3) << (cw ? "clockwise" : "counter-clockwise");
+  }
+}
 
 }  // namespace
 }  // namespace paddock::sensors

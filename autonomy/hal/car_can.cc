@@ -1,0 +1,257 @@
+#include "autonomy/hal/car_can.h"
+
+#include <cmath>
+#include <cstddef>
+#include <stdexcept>
+
+#include "autonomy/common/params.h"
+
+#if __has_include(<linux/can.h>)
+#include <linux/can.h>
+static_assert(sizeof(struct can_frame) == paddock::hal::kSocketCanFrameSize, "struct can_frame is 16 bytes");
+static_assert(offsetof(struct can_frame, data) == 8, "struct can_frame's data at byte 8");
+#else
+// linux/can.h's flags of can_id
+#define CAN_EFF_FLAG 0x80000000U
+#define CAN_RTR_FLAG 0x40000000U
+#define CAN_ERR_FLAG 0x20000000U
+#define CAN_SFF_MASK 0x000007FFU
+#define CAN_EFF_MASK 0x1FFFFFFFU
+#endif
+
+namespace paddock::hal {
+
+namespace {
+
+// what the car needs of a signal: its unit, the physical range it must carry
+// without clipping, the coarsest step that will do; `integer` values (a flag,
+// an enum) must come through exactly: factor 1, offset 0
+struct Need {
+  const char* signal;
+  const char* unit;
+  double lo, hi, step;
+  bool integer = false;
+};
+
+struct MessageNeed {
+  const char* name;
+  std::array<Need, 5> signals;  // the first ones; the rest without a name
+};
+
+// the car's messages and signals, in CarCan::Kind's order; the ranges: a
+// racing car's 5 g and 5 rad/s, wheels to 300 rad/s (60 m/s on a 0.2 m tyre),
+// the road wheels past their 0.52 rad lock, 3 kN m of torque vectoring
+constexpr MessageNeed kCar[] = {
+    {"RES_Status", {{{"Go", "", 0.0, 1.0, 1.0, true}, {"Emergency", "", 0.0, 1.0, 1.0, true}}}},
+    {"ACU_Command",
+     {{{"SteeringAngleRequest", "rad", -0.6, 0.6, 1e-3},
+       {"DriveTorqueRequest", "", 0.0, 1.0, 1e-3},
+       {"BrakeRequest", "", 0.0, 1.0, 1e-3},
+       {"YawMomentRequest", "Nm", -3000.0, 3000.0, 1.0},
+       {"AsState", "", 0.0, 4.0, 1.0, true}}}},
+    {"IMU_Accel",
+     {{{"Ax", "m/s^2", -49.0, 49.0, 1e-2}, {"Ay", "m/s^2", -49.0, 49.0, 1e-2}, {"Az", "m/s^2", -49.0, 49.0, 1e-2}}}},
+    {"IMU_Rate",
+     {{{"RollRate", "rad/s", -5.0, 5.0, 1e-3},
+       {"PitchRate", "rad/s", -5.0, 5.0, 1e-3},
+       {"YawRate", "rad/s", -5.0, 5.0, 1e-3}}}},
+    {"WheelSpeeds",
+     {{{"FL", "rad/s", -300.0, 300.0, 0.05},
+       {"FR", "rad/s", -300.0, 300.0, 0.05},
+       {"RL", "rad/s", -300.0, 300.0, 0.05},
+       {"RR", "rad/s", -300.0, 300.0, 0.05}}}},
+    {"SteeringAngle", {{{"Angle", "rad", -0.6, 0.6, 1e-3}}}},
+};
+
+// a little-endian u32
+void put_u32(std::uint8_t* p, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = static_cast<std::uint8_t>(v >> (8 * i));
+}
+std::uint32_t get_u32(const std::uint8_t* p) {
+  return static_cast<std::uint32_t>(p[0]) | static_cast<std::uint32_t>(p[1]) << 8 |
+         static_cast<std::uint32_t>(p[2]) << 16 | static_cast<std::uint32_t>(p[3]) << 24;
+}
+
+}  // namespace
+
+void to_socketcan(const CanFrame& frame, std::uint8_t out[kSocketCanFrameSize]) {
+  put_u32(out, frame.extended ? (frame.id & CAN_EFF_MASK) | CAN_EFF_FLAG : frame.id & CAN_SFF_MASK);
+  out[4] = frame.dlc;
+  out[5] = out[6] = out[7] = 0;
+  for (std::size_t i = 0; i < 8; ++i) out[8 + i] = i < frame.dlc ? frame.data[i] : 0;
+}
+
+std::optional<CanFrame> from_socketcan(const std::uint8_t* p, std::size_t n, TimeNs stamp) {
+  if (n != kSocketCanFrameSize) return std::nullopt;
+  const std::uint32_t can_id = get_u32(p);
+  // remote and error frames carry no data; a standard id has 11 bits
+  if ((can_id & (CAN_RTR_FLAG | CAN_ERR_FLAG)) != 0 || p[4] > 8) return std::nullopt;
+  CanFrame f;
+  f.stamp = stamp;
+  f.extended = (can_id & CAN_EFF_FLAG) != 0;
+  f.id = can_id & CAN_EFF_MASK;
+  if (!f.extended && f.id > CAN_SFF_MASK) return std::nullopt;
+  f.dlc = p[4];
+  for (std::size_t i = 0; i < f.dlc; ++i) f.data[i] = p[8 + i];
+  return f;
+}
+
+CarCan::CarCan(const Dbc& dbc, const std::string& source) {
+  // each of the car's messages by name, and its signals
+  for (std::size_t k = 0; k < kKinds; ++k) {
+    const MessageNeed& need = kCar[k];
+    const DbcMessage* m = dbc.find(need.name);
+    if (!m) throw std::invalid_argument(source + ": no message " + need.name + ", expected the car's messages");
+    msg_[k] = Message{m->id, m->extended, m->dlc, {}};
+    for (const Need& n : need.signals) {
+      if (!n.signal) break;
+      const DbcSignal* s = m->find(n.signal);
+      const std::string what = "message " + m->name + ": ";
+      if (!s) throw std::invalid_argument(source + ": " + what + "no signal " + n.signal);
+      // its unit, range and step
+      const std::string at = source + ":" + std::to_string(s->line) + ": " + what + "signal " + s->name + ": ";
+      if (s->unit != n.unit) throw std::invalid_argument(at + "unit \"" + s->unit + "\", expected \"" + n.unit + "\"");
+      if (s->lowest() > n.lo || s->highest() < n.hi) {
+        throw std::invalid_argument(at + "carries [" + params::number(s->lowest()) + ", " +
+                                    params::number(s->highest()) + "], expected at least [" + params::number(n.lo) +
+                                    ", " + params::number(n.hi) + "]");
+      }
+      if (n.integer ? s->factor != 1.0 || s->offset != 0.0 : std::abs(s->factor) > n.step) {
+        throw std::invalid_argument(at + "factor " + params::number(s->factor) + " offset " +
+                                    params::number(s->offset) +
+                                    (n.integer ? ", expected factor 1 offset 0 (integer values)"
+                                               : ", expected a step of " + params::number(n.step) + " or finer"));
+      }
+      msg_[k].signals.push_back(*s);
+    }
+  }
+}
+
+// one message's frame: each value into its signal, the ones that do not fit counted
+CanFrame CarCan::frame(Kind k, TimeNs stamp, std::initializer_list<double> values) {
+  const Message& m = msg_[k];
+  CanFrame f{stamp, m.id, m.extended, m.dlc, {}};
+  const DbcSignal* s = m.signals.data();
+  for (const double v : values) {
+    if (!(s++)->encode(v, f.data.data())) ++(std::isfinite(v) ? counters_.saturated : counters_.nonfinite);
+  }
+  ++counters_.encoded;
+  return f;
+}
+
+std::vector<CanFrame> CarCan::encode(const Imu& m) {
+  return {frame(kImuAccel, m.stamp, {m.ax, m.ay, m.az}),
+          frame(kImuRate, m.stamp, {m.roll_rate, m.pitch_rate, m.yaw_rate})};
+}
+
+CanFrame CarCan::encode(const WheelSpeeds& m) {
+  return frame(kWheels, m.stamp, {m.omega[0], m.omega[1], m.omega[2], m.omega[3]});
+}
+
+CanFrame CarCan::encode(const SteeringAngle& m) { return frame(kSteering, m.stamp, {m.angle}); }
+
+CanFrame CarCan::encode(const ResSignal& m) {
+  return frame(kRes, m.stamp, {m.go ? 1.0 : 0.0, m.emergency ? 1.0 : 0.0});
+}
+
+CanFrame CarCan::encode(const ActuatorCommand& m) {
+  // a command that is no number fails safe: no drive, full brake (a NaN
+  // brake sent as raw 0 would release it); still counted as non-finite
+  const double throttle = std::isnan(m.throttle) ? 0.0 : m.throttle;
+  const double brake = std::isnan(m.brake) ? 1.0 : m.brake;
+  if (std::isnan(m.throttle)) ++counters_.nonfinite;
+  if (std::isnan(m.brake)) ++counters_.nonfinite;
+  return frame(kCommand, m.stamp,
+               {m.steering_angle, throttle, brake, m.yaw_moment, static_cast<double>(static_cast<int>(m.as_state))});
+}
+
+void CarCan::push(const CanFrame& f) {
+  ++counters_.frames;
+  // which of the car's messages, and whole
+  std::size_t k = 0;
+  while (k < kKinds && !(msg_[k].id == f.id && msg_[k].extended == f.extended)) ++k;
+  if (k == kKinds) {
+    ++counters_.unknown_id;
+    return;
+  }
+  if (f.dlc != msg_[k].dlc) {
+    ++counters_.bad_dlc;
+    return;
+  }
+  const auto v = [&](std::size_t i) { return msg_[k].signals[i].decode(f.data.data()); };
+  switch (k) {
+    case kRes:
+      sensors_.push_back(ResSignal{f.stamp, v(0) != 0.0, v(1) != 0.0});
+      ++counters_.res;
+      break;
+    case kCommand: {
+      // AsState's raw value is the enum's (factor 1, offset 0): 0..4
+      const double as = v(4);
+      if (as < 0.0 || as > static_cast<double>(AsState::Emergency)) {
+        ++counters_.bad_value;
+        return;
+      }
+      commands_.push_back(ActuatorCommand{f.stamp, v(0), v(1), v(2), v(3), static_cast<AsState>(static_cast<int>(as))});
+      ++counters_.commands;
+      break;
+    }
+    case kImuAccel:
+    case kImuRate:
+      imu_half(k - kImuAccel, f.stamp, {v(0), v(1), v(2)});
+      break;
+    case kWheels:
+      sensors_.push_back(WheelSpeeds{f.stamp, {v(0), v(1), v(2), v(3)}});
+      ++counters_.wheel_speeds;
+      break;
+    case kSteering:
+      sensors_.push_back(SteeringAngle{f.stamp, v(0)});
+      ++counters_.steering;
+      break;
+  }
+}
+
+// pairs the IMU's two frames by stamp: the older of two halves that cannot pair is dropped
+void CarCan::imu_half(std::size_t half, TimeNs stamp, const std::array<double, 3>& v) {
+  ImuHalf& mine = imu_[half];
+  ImuHalf& other = imu_[1 - half];
+  // a half older than a waiting one is stale: its partner was lost or passed
+  if ((mine.waiting && mine.stamp > stamp) || (other.waiting && other.stamp > stamp)) {
+    ++counters_.unmatched_imu_halves;
+    return;
+  }
+  // a waiting half of the same kind, or an older other half, never pairs now
+  if (mine.waiting) {
+    mine.waiting = false;
+    ++counters_.unmatched_imu_halves;
+  }
+  if (other.waiting && other.stamp < stamp) {
+    other.waiting = false;
+    ++counters_.unmatched_imu_halves;
+  }
+  if (!other.waiting) {
+    mine = ImuHalf{true, stamp, v};
+    return;
+  }
+  // the pair: accel ax, ay, az; rate roll, pitch, yaw
+  other.waiting = false;
+  const std::array<double, 3>& a = half == 0 ? v : other.v;
+  const std::array<double, 3>& r = half == 0 ? other.v : v;
+  sensors_.push_back(Imu{stamp, a[0], a[1], r[2], a[2], r[0], r[1]});
+  ++counters_.imu;
+}
+
+std::optional<SensorMessage> CarCan::pop_sensor() {
+  if (sensors_.empty()) return std::nullopt;
+  SensorMessage m = std::move(sensors_.front());
+  sensors_.pop_front();
+  return m;
+}
+
+std::optional<ActuatorCommand> CarCan::pop_command() {
+  if (commands_.empty()) return std::nullopt;
+  const ActuatorCommand c = commands_.front();
+  commands_.pop_front();
+  return c;
+}
+
+}  // namespace paddock::hal
