@@ -25,13 +25,19 @@ namespace {
 
 // what the car needs of a signal: its unit, the physical range it must carry
 // without clipping, the coarsest step that will do; `integer` values (a flag,
-// an enum) must come through exactly: factor 1, offset 0
+// an enum, a counter) must come through exactly: factor 1, offset 0; a
+// counter that wraps at 2^bits needs exactly that many `bits` (0: any length)
 struct Need {
   const char* signal;
   const char* unit;
   double lo, hi, step;
   bool integer = false;
+  int bits = 0;
 };
+
+// the IMU frames' rolling counter: 4 bits, +1 mod 16 per sample
+constexpr int kImuCounterBits = 4;
+constexpr std::uint8_t kImuCounterMask = (1U << kImuCounterBits) - 1;
 
 struct MessageNeed {
   const char* name;
@@ -40,7 +46,8 @@ struct MessageNeed {
 
 // the car's messages and signals, in CarCan::Kind's order; the ranges: a
 // racing car's 5 g and 5 rad/s, wheels to 300 rad/s (60 m/s on a 0.2 m tyre),
-// the road wheels past their 0.52 rad lock, 3 kN m of torque vectoring
+// the road wheels past their 0.52 rad lock, 3 kN m of torque vectoring; the
+// IMU's Counter is the fourth signal of both its frames
 constexpr MessageNeed kCar[] = {
     {"RES_Status", {{{"Go", "", 0.0, 1.0, 1.0, true}, {"Emergency", "", 0.0, 1.0, 1.0, true}}}},
     {"ACU_Command",
@@ -50,11 +57,15 @@ constexpr MessageNeed kCar[] = {
        {"YawMomentRequest", "Nm", -3000.0, 3000.0, 1.0},
        {"AsState", "", 0.0, 4.0, 1.0, true}}}},
     {"IMU_Accel",
-     {{{"Ax", "m/s^2", -49.0, 49.0, 1e-2}, {"Ay", "m/s^2", -49.0, 49.0, 1e-2}, {"Az", "m/s^2", -49.0, 49.0, 1e-2}}}},
+     {{{"Ax", "m/s^2", -49.0, 49.0, 1e-2},
+       {"Ay", "m/s^2", -49.0, 49.0, 1e-2},
+       {"Az", "m/s^2", -49.0, 49.0, 1e-2},
+       {"Counter", "", 0.0, kImuCounterMask, 1.0, true, kImuCounterBits}}}},
     {"IMU_Rate",
      {{{"RollRate", "rad/s", -5.0, 5.0, 1e-3},
        {"PitchRate", "rad/s", -5.0, 5.0, 1e-3},
-       {"YawRate", "rad/s", -5.0, 5.0, 1e-3}}}},
+       {"YawRate", "rad/s", -5.0, 5.0, 1e-3},
+       {"Counter", "", 0.0, kImuCounterMask, 1.0, true, kImuCounterBits}}}},
     {"WheelSpeeds",
      {{{"FL", "rad/s", -300.0, 300.0, 0.05},
        {"FR", "rad/s", -300.0, 300.0, 0.05},
@@ -111,6 +122,10 @@ CarCan::CarCan(const Dbc& dbc, const std::string& source) {
       // its unit, range and step
       const std::string at = source + ":" + std::to_string(s->line) + ": " + what + "signal " + s->name + ": ";
       if (s->unit != n.unit) throw std::invalid_argument(at + "unit \"" + s->unit + "\", expected \"" + n.unit + "\"");
+      if (n.bits != 0 && s->length != n.bits) {
+        throw std::invalid_argument(at + "length " + std::to_string(s->length) + " bits, expected " +
+                                    std::to_string(n.bits) + " (a counter mod " + std::to_string(1 << n.bits) + ")");
+      }
       if (s->lowest() > n.lo || s->highest() < n.hi) {
         throw std::invalid_argument(at + "carries [" + params::number(s->lowest()) + ", " +
                                     params::number(s->highest()) + "], expected at least [" + params::number(n.lo) +
@@ -140,8 +155,11 @@ CanFrame CarCan::frame(Kind k, TimeNs stamp, std::initializer_list<double> value
 }
 
 std::vector<CanFrame> CarCan::encode(const Imu& m) {
-  return {frame(kImuAccel, m.stamp, {m.ax, m.ay, m.az}),
-          frame(kImuRate, m.stamp, {m.roll_rate, m.pitch_rate, m.yaw_rate})};
+  // both halves of the sample carry the same counter, the next sample the next
+  const double counter = imu_counter_;
+  imu_counter_ = static_cast<std::uint8_t>((imu_counter_ + 1) & kImuCounterMask);
+  return {frame(kImuAccel, m.stamp, {m.ax, m.ay, m.az, counter}),
+          frame(kImuRate, m.stamp, {m.roll_rate, m.pitch_rate, m.yaw_rate, counter})};
 }
 
 CanFrame CarCan::encode(const WheelSpeeds& m) {
@@ -197,7 +215,9 @@ void CarCan::push(const CanFrame& f) {
     }
     case kImuAccel:
     case kImuRate:
-      imu_half(k - kImuAccel, f.stamp, {v(0), v(1), v(2)});
+      // the Counter's raw value is the counter (4 bits, factor 1, offset 0)
+      imu_half(k - kImuAccel, static_cast<std::uint8_t>(msg_[k].signals[3].raw(f.data.data()) & kImuCounterMask),
+               f.stamp, {v(0), v(1), v(2)});
       break;
     case kWheels:
       sensors_.push_back(WheelSpeeds{f.stamp, {v(0), v(1), v(2), v(3)}});
@@ -210,34 +230,22 @@ void CarCan::push(const CanFrame& f) {
   }
 }
 
-// pairs the IMU's two frames by stamp: the older of two halves that cannot pair is dropped
-void CarCan::imu_half(std::size_t half, TimeNs stamp, const std::array<double, 3>& v) {
-  ImuHalf& mine = imu_[half];
-  ImuHalf& other = imu_[1 - half];
-  // a half older than a waiting one is stale: its partner was lost or passed
-  if ((mine.waiting && mine.stamp > stamp) || (other.waiting && other.stamp > stamp)) {
-    ++counters_.unmatched_imu_halves;
+// pairs the IMU's two frames by their counter (their stamps differ on the
+// car): the waiting half pairs with the other half of the same counter; any
+// other IMU frame (a later sample's, or a repeat of the waiting half) means
+// the waiting half's partner is lost, and it is dropped for the new one
+void CarCan::imu_half(std::size_t half, std::uint8_t counter, TimeNs stamp, const std::array<double, 3>& v) {
+  if (imu_.waiting && imu_.half != half && imu_.counter == counter) {
+    // the pair, stamped with its first half: accel ax, ay, az; rate roll, pitch, yaw
+    imu_.waiting = false;
+    const std::array<double, 3>& a = half == 0 ? v : imu_.v;
+    const std::array<double, 3>& r = half == 0 ? imu_.v : v;
+    sensors_.push_back(Imu{imu_.stamp, a[0], a[1], r[2], a[2], r[0], r[1]});
+    ++counters_.imu;
     return;
   }
-  // a waiting half of the same kind, or an older other half, never pairs now
-  if (mine.waiting) {
-    mine.waiting = false;
-    ++counters_.unmatched_imu_halves;
-  }
-  if (other.waiting && other.stamp < stamp) {
-    other.waiting = false;
-    ++counters_.unmatched_imu_halves;
-  }
-  if (!other.waiting) {
-    mine = ImuHalf{true, stamp, v};
-    return;
-  }
-  // the pair: accel ax, ay, az; rate roll, pitch, yaw
-  other.waiting = false;
-  const std::array<double, 3>& a = half == 0 ? v : other.v;
-  const std::array<double, 3>& r = half == 0 ? other.v : v;
-  sensors_.push_back(Imu{stamp, a[0], a[1], r[2], a[2], r[0], r[1]});
-  ++counters_.imu;
+  if (imu_.waiting) ++counters_.unmatched_imu_halves;
+  imu_ = ImuHalf{true, half, counter, stamp, v};
 }
 
 std::optional<SensorMessage> CarCan::pop_sensor() {

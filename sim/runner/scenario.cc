@@ -319,7 +319,8 @@ std::string resolved_ini(const Scenario& scenario) {
     }
     const std::string v = k.get();
     const std::string comment = k.unit.empty() ? k.doc : k.doc.empty() ? k.unit : k.unit + ", " + k.doc;
-    if (v.empty()) o << "; " << k.name << " =  ; (not checked) " << comment << "\n";
+    // an unset optional value stays a comment; an empty text is a value
+    if (v.empty() && k.expected != "text") o << "; " << k.name << " =  ; (not checked) " << comment << "\n";
     else o << k.name << " = " << v << "  ; " << comment << "\n";
   }
   return o.str();

@@ -1,7 +1,8 @@
 // the car's CAN: the shipped DBC parses and carries every HAL message to within
 // half a step (exactly on the grid), saturates at its limits, pairs the IMU's
-// two frames, counts what it drops, and refuses DBC files it cannot use, each
-// error naming the file and line.
+// two frames by their rolling counter (not their stamps, which differ on the
+// car), counts what it drops, and refuses DBC files it cannot use, each error
+// naming the file and line.
 #include "autonomy/hal/car_can.h"
 
 #include <gtest/gtest.h>
@@ -51,6 +52,21 @@ void push_all(CarCan& can, const std::vector<CanFrame>& frames) {
   for (const CanFrame& f : frames) can.push(f);
 }
 
+// the IMU counter an IMU_Accel or IMU_Rate frame carries, read with the
+// shipped DBC's Counter signal
+int counter(const CanFrame& f) {
+  static const Dbc dbc = parse_dbc(shipped(), kSource);
+  const DbcMessage* m = dbc.find(f.id, f.extended);
+  EXPECT_TRUE(m && m->find("Counter")) << f.id;
+  return m && m->find("Counter") ? static_cast<int>(m->find("Counter")->raw(f.data.data())) : -1;
+}
+
+// a frame as received at `stamp`
+CanFrame received(CanFrame f, TimeNs stamp) {
+  f.stamp = stamp;
+  return f;
+}
+
 // ------------------------------------------------------------ the shipped DBC
 
 TEST(CarCan, ShippedDbcParsesAndIsTheCars) {
@@ -68,6 +84,19 @@ TEST(CarCan, ShippedDbcParsesAndIsTheCars) {
   // both byte orders on the real bus; every message and signal commented
   EXPECT_EQ(dbc.find("SteeringAngle")->find("Angle")->order, ByteOrder::Motorola);
   EXPECT_EQ(dbc.find("IMU_Accel")->find("Az")->order, ByteOrder::Intel);
+  // the IMU's two frames share a 4-bit rolling counter in their top bits
+  for (const char* imu : {"IMU_Accel", "IMU_Rate"}) {
+    const DbcSignal* c = dbc.find(imu)->find("Counter");
+    ASSERT_NE(c, nullptr) << imu;
+    EXPECT_EQ(c->start, 60) << imu;
+    EXPECT_EQ(c->length, 4) << imu;
+    EXPECT_EQ(c->order, ByteOrder::Intel) << imu;
+    EXPECT_FALSE(c->is_signed) << imu;
+    EXPECT_EQ(c->factor, 1.0) << imu;
+    EXPECT_EQ(c->offset, 0.0) << imu;
+    EXPECT_EQ(c->highest(), 15.0) << imu;
+    EXPECT_NE(c->comment.find("mod 16"), std::string::npos) << imu;
+  }
   for (const DbcMessage& m : dbc.messages) {
     EXPECT_FALSE(m.extended);
     EXPECT_FALSE(m.comment.empty()) << m.name;
@@ -218,10 +247,12 @@ TEST(CarCan, OutOfRangeSaturatesAndNonFiniteIsCounted) {
 
 // ------------------------------------------------------------ decoding
 
-TEST(CarCan, ImuHalvesPairByStamp) {
+TEST(CarCan, ImuHalvesPairByCounter) {
   CarCan can = car();
   const std::vector<CanFrame> a = can.encode(Imu{100, 1, 2, 3, 4, 5, 6}),
                               b = can.encode(Imu{200, 7, 8, 0.9, 10, 1.1, 1.2});
+  EXPECT_EQ(counter(a[0]), 0);
+  EXPECT_EQ(counter(b[0]), 1);
   // in order, and the rate frame first
   push_all(can, {a[0], a[1]});
   EXPECT_EQ(only_sensor<Imu>(can).stamp, 100);
@@ -235,29 +266,130 @@ TEST(CarCan, ImuHalvesPairByStamp) {
   EXPECT_DOUBLE_EQ(im.roll_rate, 1.1);
   EXPECT_DOUBLE_EQ(im.pitch_rate, 1.2);
   EXPECT_EQ(can.counters().unmatched_imu_halves, 0u);
-  // a missing half: accel 100 never meets its rate, accel 200 does
-  push_all(can, {a[0], b[0], b[1]});
-  EXPECT_EQ(only_sensor<Imu>(can).stamp, 200);
+  // the counter pairs, not the stamp: halves of one stamp but two samples do not
+  push_all(can, {a[0], received(b[1], 100)});
+  EXPECT_FALSE(can.pop_sensor().has_value());
   EXPECT_EQ(can.counters().unmatched_imu_halves, 1u);
-  // a stale half: the rate of 100 comes after the accel of 200 is waiting
-  push_all(can, {b[0], a[1]});
-  EXPECT_FALSE(can.pop_sensor().has_value());
-  EXPECT_EQ(can.counters().unmatched_imu_halves, 2u);
-  can.push(b[1]);
-  EXPECT_EQ(only_sensor<Imu>(can).stamp, 200);
-  // a newer half drops an older waiting half of the other kind
-  push_all(can, {a[1], b[0]});
-  EXPECT_FALSE(can.pop_sensor().has_value());
-  EXPECT_EQ(can.counters().unmatched_imu_halves, 3u);
-  can.push(b[1]);
-  EXPECT_EQ(only_sensor<Imu>(can).stamp, 200);
-  EXPECT_EQ(can.counters().imu, 5u);
+  can.push(b[0]);
+  EXPECT_EQ(only_sensor<Imu>(can).stamp, 100);  // the waiting rate's stamp, the first half's
+  EXPECT_EQ(can.counters().imu, 3u);
   // other messages keep their arrival order around the pair
   push_all(can, {a[0], can.encode(WheelSpeeds{100, {}}), a[1]});
   auto first = can.pop_sensor(), second = can.pop_sensor();
   ASSERT_TRUE(first && second);
   EXPECT_TRUE(std::holds_alternative<WheelSpeeds>(*first));
   EXPECT_TRUE(std::holds_alternative<Imu>(*second));
+}
+
+// the car's case: SocketCAN stamps each frame at its arrival, so the two
+// halves of a sample differ by a fraction of a millisecond; the sender and the
+// receiver are two CarCans (the VCU's and the stack's)
+TEST(CarCan, ImuHalvesWithTheirOwnReceiveTimesPair) {
+  CarCan vcu = car(), acu = car();
+  const double acc = step("IMU_Accel", "Ax"), rate = step("IMU_Rate", "YawRate");
+  constexpr TimeNs kPeriod = 5'000'000, kLatency = 100'000, kGap = 300'000;  // 200 Hz; the halves 0.3 ms apart
+  for (int i = 0; i < 40; ++i) {  // past the counter's wrap, twice
+    const TimeNs t = kPeriod * i;
+    const Imu imu{t, 0.5 * i, -0.25 * i, 0.01 * i, 9.81, -0.02 * i, 0.03 * i};
+    const std::vector<CanFrame> f = vcu.encode(imu);
+    // the accel frame first, and every third sample the rate frame first
+    const std::size_t one = i % 3 == 2 ? 1 : 0;
+    acu.push(received(f[one], t + kLatency));
+    EXPECT_FALSE(acu.pop_sensor().has_value()) << i;
+    acu.push(received(f[1 - one], t + kLatency + kGap));
+    const Imu im = only_sensor<Imu>(acu);
+    EXPECT_EQ(im.stamp, t + kLatency) << i;  // the first half's receive time
+    EXPECT_NEAR(im.ax, imu.ax, acc / 2 * (1 + 1e-9)) << i;
+    EXPECT_NEAR(im.ay, imu.ay, acc / 2 * (1 + 1e-9)) << i;
+    EXPECT_NEAR(im.az, imu.az, acc / 2 * (1 + 1e-9)) << i;
+    EXPECT_NEAR(im.roll_rate, imu.roll_rate, rate / 2 * (1 + 1e-9)) << i;
+    EXPECT_NEAR(im.pitch_rate, imu.pitch_rate, rate / 2 * (1 + 1e-9)) << i;
+    EXPECT_NEAR(im.yaw_rate, imu.yaw_rate, rate / 2 * (1 + 1e-9)) << i;
+  }
+  EXPECT_EQ(acu.counters().imu, 40u);
+  EXPECT_EQ(acu.counters().unmatched_imu_halves, 0u);
+  EXPECT_EQ(vcu.counters().encoded, 80u);
+}
+
+TEST(CarCan, StaleAndRepeatedImuHalvesAreDropped) {
+  CarCan vcu = car(), acu = car();
+  std::vector<std::vector<CanFrame>> s;  // sample i, counter i, measured at i ms
+  for (int i = 0; i < 8; ++i) s.push_back(vcu.encode(Imu{1'000'000 * i, 1.0 * i, 0, 0, 0, 0, 0}));
+  const auto at = [](const CanFrame& f, TimeNs extra) { return received(f, f.stamp + extra); };
+  // a lost rate: accel 0 waits; accel 1, another counter, drops it and pairs with rate 1
+  push_all(acu, {s[0][0], s[1][0], at(s[1][1], 300'000)});
+  Imu im = only_sensor<Imu>(acu);
+  EXPECT_EQ(im.stamp, 1'000'000);
+  EXPECT_DOUBLE_EQ(im.ax, 1.0);
+  EXPECT_EQ(acu.counters().unmatched_imu_halves, 1u);
+  // a lost accel, the rate waiting: rate 3 drops rate 2
+  push_all(acu, {s[2][1], s[3][1], at(s[3][0], 300'000)});
+  im = only_sensor<Imu>(acu);
+  EXPECT_EQ(im.stamp, 3'000'000);
+  EXPECT_DOUBLE_EQ(im.ax, 3.0);
+  EXPECT_EQ(acu.counters().unmatched_imu_halves, 2u);
+  // a stale half, rate 3 again after accel 4: neither pairs; the stale one
+  // waits until the next frame, rate 4, drops it (and rate 4 lost its accel)
+  push_all(acu, {s[4][0], at(s[3][1], 100'000), at(s[4][1], 300'000)});
+  EXPECT_FALSE(acu.pop_sensor().has_value());
+  EXPECT_EQ(acu.counters().unmatched_imu_halves, 4u);
+  push_all(acu, {s[5][0], at(s[5][1], 300'000)});
+  EXPECT_EQ(only_sensor<Imu>(acu).stamp, 5'000'000);
+  EXPECT_EQ(acu.counters().unmatched_imu_halves, 5u);
+  // a repeat of the waiting half (the same counter, other values) replaces
+  // it: the pair has the repeat's values and stamp
+  CanFrame repeat = at(s[6][0], 200'000);
+  const Dbc dbc = parse_dbc(shipped(), kSource);
+  EXPECT_TRUE(dbc.find("IMU_Accel")->find("Ax")->encode(40.0, repeat.data.data()));
+  EXPECT_EQ(counter(repeat), 6);
+  push_all(acu, {s[6][0], repeat});
+  EXPECT_FALSE(acu.pop_sensor().has_value());
+  EXPECT_EQ(acu.counters().unmatched_imu_halves, 6u);
+  acu.push(at(s[6][1], 300'000));
+  im = only_sensor<Imu>(acu);
+  EXPECT_EQ(im.stamp, 6'200'000);
+  EXPECT_DOUBLE_EQ(im.ax, 40.0);
+  // a half repeated after its pair was made waits for a partner, and the next
+  // sample's first half drops it
+  push_all(acu, {s[7][0], s[7][1]});
+  EXPECT_EQ(only_sensor<Imu>(acu).stamp, 7'000'000);
+  acu.push(s[7][1]);
+  EXPECT_FALSE(acu.pop_sensor().has_value());
+  acu.push(vcu.encode(Imu{8'000'000, 0, 0, 0, 0, 0, 0})[0]);
+  EXPECT_EQ(acu.counters().unmatched_imu_halves, 7u);
+  EXPECT_EQ(acu.counters().imu, 5u);
+}
+
+TEST(CarCan, ImuCounterCountsSamplesModSixteen) {
+  CarCan vcu = car();
+  std::vector<std::vector<CanFrame>> s;
+  for (int i = 0; i < 35; ++i) {
+    s.push_back(vcu.encode(Imu{i, 0, 0, 0, 0, 0, 0}));
+    // one counter for both halves, one more per Imu, 15 -> 0
+    EXPECT_EQ(counter(s.back()[0]), i % 16) << i;
+    EXPECT_EQ(counter(s.back()[1]), i % 16) << i;
+  }
+  // other messages do not count; another CarCan counts its own, from 0
+  vcu.encode(WheelSpeeds{35, {}});
+  vcu.encode(SteeringAngle{35, 0.1});
+  EXPECT_EQ(counter(vcu.encode(Imu{35, 0, 0, 0, 0, 0, 0})[0]), 35 % 16);
+  CarCan other = car();
+  EXPECT_EQ(counter(other.encode(Imu{36, 0, 0, 0, 0, 0, 0})[1]), 0);
+  EXPECT_EQ(counter(vcu.encode(Imu{36, 0, 0, 0, 0, 0, 0})[1]), 36 % 16);
+  // decoding across the wrap: 15 and then 0 are two samples
+  CarCan acu = car();
+  ASSERT_EQ(counter(s[15][0]), 15);
+  ASSERT_EQ(counter(s[16][0]), 0);
+  push_all(acu, {s[15][1], s[15][0], s[16][0], s[16][1]});
+  EXPECT_EQ(std::get<Imu>(*acu.pop_sensor()).stamp, 15);
+  EXPECT_EQ(only_sensor<Imu>(acu).stamp, 16);
+  // a half of 15 does not pair with the other half of 0 (nor of 31, 16 later)
+  push_all(acu, {s[15][0], s[16][1]});
+  EXPECT_FALSE(acu.pop_sensor().has_value());
+  EXPECT_EQ(acu.counters().unmatched_imu_halves, 1u);
+  push_all(acu, {s[31][0], s[16][1]});
+  EXPECT_FALSE(acu.pop_sensor().has_value());
+  EXPECT_EQ(acu.counters().unmatched_imu_halves, 3u);
 }
 
 TEST(CarCan, ForeignAndMalformedFramesAreCountedDrops) {
@@ -402,6 +534,17 @@ TEST(CarCan, DbcWithoutTheCarsSignalsIsRefused) {
   no_az.replace(no_az.find("CM_ SG_ 384 Az"),
                 no_az.find('\n', no_az.find("CM_ SG_ 384 Az")) - no_az.find("CM_ SG_ 384 Az"), "");
   EXPECT_EQ(error(no_az), "paddock.dbc: message IMU_Accel: no signal Az");
+  // the IMU's counter, in either frame
+  for (const std::string id : {"384", "385"}) {
+    std::string no_counter = t;
+    for (const std::string& pattern : {std::string(" SG_ Counter :"), "CM_ SG_ " + id + " Counter "}) {
+      const std::size_t from = no_counter.find(pattern, id == "384" ? 0 : no_counter.find("BO_ 385 "));
+      ASSERT_NE(from, std::string::npos) << pattern;
+      no_counter.erase(from, no_counter.find('\n', from) + 1 - from);
+    }
+    EXPECT_EQ(error(no_counter),
+              std::string("paddock.dbc: message ") + (id == "384" ? "IMU_Accel" : "IMU_Rate") + ": no signal Counter");
+  }
   EXPECT_EQ(error(edited("BO_ 416 SteeringAngle:", "BO_ 416 SteerAngle:")),
             "paddock.dbc: no message SteeringAngle, expected the car's messages");
   // a unit, a range, a step it cannot carry the car's values in
@@ -415,6 +558,14 @@ TEST(CarCan, DbcWithoutTheCarsSignalsIsRefused) {
   EXPECT_EQ(error(edited("SG_ AsState : 60|3@1+ (1,0)", "SG_ AsState : 60|3@1+ (2,0)")),
             at("SG_ AsState :") +
                 "message ACU_Command: signal AsState: factor 2 offset 0, expected factor 1 offset 0 (integer values)");
+  // a counter of another length, unit or step (IMU_Accel's, the first)
+  EXPECT_EQ(error(edited("SG_ Counter : 60|4@1+ (1,0) [0|15]", "SG_ Counter : 60|3@1+ (1,0) [0|7]")),
+            at("SG_ Counter :") + "message IMU_Accel: signal Counter: length 3 bits, expected 4 (a counter mod 16)");
+  EXPECT_EQ(error(edited("SG_ Counter : 60|4@1+ (1,0) [0|15] \"\"", "SG_ Counter : 60|4@1+ (1,0) [0|15] \"n\"")),
+            at("SG_ Counter :") + "message IMU_Accel: signal Counter: unit \"n\", expected \"\"");
+  EXPECT_EQ(error(edited("SG_ Counter : 60|4@1+ (1,0) [0|15]", "SG_ Counter : 60|4@1+ (2,0) [0|30]")),
+            at("SG_ Counter :") +
+                "message IMU_Accel: signal Counter: factor 2 offset 0, expected factor 1 offset 0 (integer values)");
 }
 
 }  // namespace
