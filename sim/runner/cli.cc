@@ -1,6 +1,7 @@
 #include "sim/runner/cli.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <tuple>
@@ -11,7 +12,9 @@
 #include "sim/runner/files.h"
 #include "sim/runner/plots.h"
 #include "sim/runner/limit_report.h"
+#include "sim/runner/replay.h"
 #include "sim/runner/reports.h"
+#include "sim/runner/run_log.h"
 #include "sim/runner/report.h"
 #include "sim/runner/scenario.h"
 #include "sim/runner/schema.h"
@@ -27,13 +30,19 @@ namespace {
 
 const char* kUsage =
     "usage:\n"
-    "  paddock run SCENARIO.ini [--set section.key=value]... [--out DIR] [--json] [--quiet]\n"
+    "  paddock run SCENARIO.ini [--set section.key=value]... [--out DIR] [--json] [--quiet] [--log]\n"
     "              [--plots [PLOT OPTIONS]]\n"
     "      runs a scenario headless and prints the result; writes DIR/summary.json,\n"
     "      DIR/scenario.ini (resolved, defaults included) and DIR/log.csv\n"
     "      (DIR defaults to runs/<scenario name>). --json prints the summary as JSON;\n"
-    "      --quiet prints only failed expectations; --plots also draws the figures.\n"
+    "      --quiet prints only failed expectations; --plots also draws the figures;\n"
+    "      --log writes DIR/run.mcap (a wire run: the LiDAR's packets, the CAN frames,\n"
+    "      the stack's outputs in Foxglove's schemas).\n"
     "      Exit 3 when [expect] fails.\n"
+    "  paddock replay LOG.mcap [--set section.key=value]... [--from S] [--until S]\n"
+    "      reruns the stack on a run's log (paddock run ... --log) without the simulator:\n"
+    "      the recorded packets and frames through the car's decoders. Unchanged it gives\n"
+    "      the live run's commands bit for bit; with --set it says where they differ.\n"
     "  paddock sweep SWEEP.ini [--jobs N] [--out DIR] [--resume] [--shard i/n] [--plots]\n"
     "      runs a sweep's points (scenarios x [vary] values x seeds) on N cores (default:\n"
     "      all) into DIR (default runs/<sweep name>): DIR/points/NNNN/{scenario.ini,\n"
@@ -123,7 +132,7 @@ bool plot_option(const std::vector<std::string>& args, std::size_t& i, PlotOptio
 int cmd_run(const std::vector<std::string>& args) {
   std::string scenario_path, out_dir;
   std::vector<std::string> overrides;
-  bool json = false, quiet = false, plots = false;
+  bool json = false, quiet = false, plots = false, log = false;
   PlotOptions plot_options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -138,6 +147,7 @@ int cmd_run(const std::vector<std::string>& args) {
     else if (a == "--out") out_dir = value("--out");
     else if (a == "--json") json = true;
     else if (a == "--quiet") quiet = true;
+    else if (a == "--log") log = true;
     else if (!a.empty() && a[0] == '-') throw UserError("unknown option " + a + "\n" + kUsage);
     else if (scenario_path.empty()) scenario_path = a;
     else throw UserError("more than one scenario given: " + scenario_path + " and " + a);
@@ -150,7 +160,14 @@ int cmd_run(const std::vector<std::string>& args) {
   for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
   if (out_dir.empty()) out_dir = (std::filesystem::path("runs") / scenario.name).string();
 
-  const RunResult result = run(scenario, track);
+  // --log: DIR/run.mcap, written beside the run and put in place at its end
+  std::unique_ptr<RunLog> run_log;
+  if (log) {
+    std::filesystem::create_directories(out_dir);
+    run_log = std::make_unique<RunLog>(out_dir + "/run.mcap", scenario);
+  }
+  const RunResult result = run_log ? run(scenario, track, {run_log.get()}, run_log.get()) : run(scenario, track);
+  if (run_log) run_log->close();
   const auto failed = check_expectations(scenario.expect, result);
   const std::string js = summary_json(scenario, result, failed);
   write_file_atomic(out_dir + "/scenario.ini", resolved_ini(scenario));
@@ -411,6 +428,39 @@ int cmd_tune(const std::vector<std::string>& args) {
   return 0;
 }
 
+// replay LOG.mcap [--set k=v]... [--from S] [--until S]
+int cmd_replay(const std::vector<std::string>& args) {
+  std::string log_path;
+  ReplayOptions o;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&](const char* flag) -> std::string {
+      if (i + 1 >= args.size()) throw UserError(std::string(flag) + " needs a value");
+      return args[++i];
+    };
+    auto seconds = [&](const char* flag) {
+      const std::string v = value(flag);
+      char* end = nullptr;
+      const double x = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !std::isfinite(x) || x < 0.0)
+        throw UserError(std::string(flag) + " " + v + ": expected a time in seconds >= 0");
+      return x;
+    };
+    if (a == "--set") o.overrides.push_back(value("--set"));
+    else if (a.rfind("--set=", 0) == 0) o.overrides.push_back(a.substr(6));
+    else if (a == "--from") o.from = seconds("--from");
+    else if (a == "--until") o.until = seconds("--until");
+    else if (!a.empty() && a[0] == '-') throw UserError("unknown option " + a + "\n" + kUsage);
+    else if (log_path.empty()) log_path = a;
+    else throw UserError("more than one log given: " + log_path + " and " + a);
+  }
+  if (log_path.empty()) throw UserError(std::string("replay needs a log (run.mcap)\n") + kUsage);
+  if (o.from && o.until && *o.until < *o.from) throw UserError("--until must not be before --from");
+  const ReplayResult r = replay(log_path, o);
+  std::cout << replay_text(log_path, r);
+  return 0;
+}
+
 int cmd_check_track(const std::vector<std::string>& args) {
   if (args.empty()) throw UserError(std::string("check-track needs at least one file\n") + kUsage);
   int bad = 0;
@@ -438,6 +488,7 @@ int run_cli(const std::vector<std::string>& args) {
     const std::vector<std::string> rest(args.begin() + 1, args.end());
     if (args[0] == "run") return cmd_run(rest);
     if (args[0] == "check-track") return cmd_check_track(rest);
+    if (args[0] == "replay") return cmd_replay(rest);
     if (args[0] == "plot") return cmd_plot(rest);
     if (args[0] == "sweep") return cmd_sweep(rest);
     if (args[0] == "tune") return cmd_tune(rest);

@@ -27,13 +27,21 @@ class SimHal final : public hal::Hal {
   void post(hal::SensorMessage m) {
     if (!true_state_ && std::holds_alternative<hal::StateEstimate>(m))
       throw std::logic_error("the true state may not cross the HAL: the stack estimates its own (slam != ground_truth)");
-    if (wire_ && WireLink::on_can(m)) return wire_->carry(m, inbox_);
+    if (wire_ && WireLink::on_can(m)) return wire_->carry(m, inbox_, now_);
     if (wire_ && wire_->has_lidar() && std::holds_alternative<hal::LidarScan>(m))
       throw std::logic_error("transport = wire: the LiDAR's scans cross the HAL as its packets (post_lidar)");
+    if (tap_) tap_->message(now_, m);
     inbox_.push_back(std::move(m));
   }
   // transport = wire: one LiDAR rotation's packets, decoded by the car's decoder
-  void post_lidar(const std::vector<std::uint8_t>& packets) { wire_->carry_lidar(packets, inbox_); }
+  void post_lidar(const std::vector<std::uint8_t>& packets) { wire_->carry_lidar(packets, inbox_, now_); }
+  // the simulation's instant: what is posted and sent now crosses at it
+  void set_now(TimeNs now) { now_ = now; }
+  // who watches the traffic (a run's log); none: nobody
+  void set_tap(WireTap* tap) {
+    tap_ = tap;
+    if (wire_) wire_->set_tap(tap);
+  }
   bool true_state() const { return true_state_; }
   // the wire, when transport = wire
   WireLink* wire() const { return wire_.get(); }
@@ -46,20 +54,25 @@ class SimHal final : public hal::Hal {
   // the command as the actuators take it: with the wire, what the car's VCU
   // decoded from the stack's frame (a frame it dropped leaves the last one)
   void send(const hal::ActuatorCommand& c) override {
+    sent_ = c;
     if (!wire_) {
       command_ = c;
-    } else if (std::optional<hal::ActuatorCommand> d = wire_->carry(c)) {
+    } else if (std::optional<hal::ActuatorCommand> d = wire_->carry(c, now_)) {
       command_ = *d;
     }
   }
-  // the last command sent, if any
+  // the last command as the actuators took it, if any
   const std::optional<hal::ActuatorCommand>& command() const { return command_; }
+  // the last command as the stack sent it (before a wire quantised it)
+  const std::optional<hal::ActuatorCommand>& sent() const { return sent_; }
 
  private:
   bool true_state_ = true;
   std::unique_ptr<WireLink> wire_;
+  WireTap* tap_ = nullptr;
+  TimeNs now_ = 0;
   std::deque<hal::SensorMessage> inbox_;
-  std::optional<hal::ActuatorCommand> command_;
+  std::optional<hal::ActuatorCommand> command_, sent_;
 };
 
 }  // namespace paddock::runner

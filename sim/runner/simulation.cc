@@ -111,6 +111,7 @@ void sample(const SimModel& model, SimState& s, const Pose2& base) {
 // what falls due at the state's instant, in the order a car meets it: the
 // sensors' measurements, the control cycle, the event's sample
 void run_due(const SimModel& model, SimState& s) {
+  s.hal.set_now(s.now);
   const Pose2 base = vehicle::base_pose(model.scenario.vehicle, s.car);
   if (!model.raw_perception && s.k % model.every.cone_sensor == 0) measure_cones(s, base);
   // a LiDAR rotation that ends now, cast from the poses it was taken at
@@ -176,7 +177,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 }  // namespace
 
-SimState::SimState(const SimModel& model)
+SimState::SimState(const SimModel& model, WireTap* tap)
     : car(vehicle::initial_state(model.scenario.vehicle, model.start)),
       cones(model.cones, model.scenario.cones,
             world::Footprint{-model.footprint.x_min, model.footprint.x_max, model.footprint.y_max}),
@@ -191,6 +192,7 @@ SimState::SimState(const SimModel& model)
       wheel_speeds(model.scenario.wheel_speeds, stream_seed(model.scenario.scenario.seed, "wheel_speeds")),
       steering(model.scenario.steering_sensor, stream_seed(model.scenario.scenario.seed, "steering_sensor")),
       true_poses(model.pose_history_span) {
+  hal.set_tap(tap);
   run_due(model, *this);
 }
 
@@ -224,7 +226,8 @@ void step(const SimModel& model, SimState& s) {
   run_due(model, s);
 }
 
-RunResult run(const Scenario& scenario, const world::TrackModel& track) {
+RunResult run(const Scenario& scenario, const world::TrackModel& track, const std::vector<Observer*>& extra,
+              WireTap* tap) {
   const auto wall0 = std::chrono::steady_clock::now();
   // the limit lap, on a second thread while the run goes on: it reads only
   // the vehicle's parameters and the track
@@ -239,7 +242,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track) {
     });
   }
   const SimModel model = compile_model(scenario, track);
-  SimState state(model);
+  SimState state(model, tap);
   LogRecorder log;
   PerceptionScorer scorer;
   SlamScorer slam;
@@ -247,6 +250,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track) {
   Observer* const observers[] = {&snapshot, &scorer, &slam, &log};
   for (;;) {
     for (Observer* o : observers) o->observe(model, state);
+    for (Observer* o : extra) o->observe(model, state);
     if (state.done) break;
     step(model, state);
   }

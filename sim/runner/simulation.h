@@ -40,7 +40,8 @@ struct SimState {
   // the world at t = 0 (car at the start pose, at rest, brakes on; cones in
   // place; every sensor's random stream seeded), with what falls due at t = 0
   // already run. The model must outlive the state.
-  explicit SimState(const SimModel& model);
+  // tap: who watches the HAL's traffic from the first instant on (a run's log)
+  explicit SimState(const SimModel& model, WireTap* tap = nullptr);
   SimState(const SimState&) = delete;
   SimState& operator=(const SimState&) = delete;
 
@@ -130,7 +131,9 @@ struct RunResult {
 };
 
 // runs one scenario to its end (finish or DNF); deterministic for a given
-// scenario and build, apart from wall_time
-RunResult run(const Scenario& scenario, const world::TrackModel& track);
+// scenario and build, apart from wall_time. `extra`: observers the caller
+// adds (a run's log), after the run's own
+RunResult run(const Scenario& scenario, const world::TrackModel& track, const std::vector<Observer*>& extra = {},
+              WireTap* tap = nullptr);
 
 }  // namespace paddock::runner

@@ -23,23 +23,24 @@ bool WireLink::on_can(const hal::SensorMessage& m) {
 
 // one frame onto the bus and off it: the 16 bytes of struct can_frame, read
 // back with the frame's time as the receive stamp
-void WireLink::carry_frame(const hal::CanFrame& f, hal::CarCan& to) {
+void WireLink::carry_frame(const hal::CanFrame& f, hal::CarCan& to, bool to_stack, TimeNs now) {
   std::uint8_t bytes[hal::kSocketCanFrameSize];
   hal::to_socketcan(f, bytes);
+  if (tap_) tap_->can_frame(now, to_stack, bytes);
   ++counters_.can_frames;
   counters_.can_bytes += hal::kSocketCanFrameSize;
   if (const std::optional<hal::CanFrame> r = hal::from_socketcan(bytes, sizeof bytes, f.stamp)) to.push(*r);
 }
 
-void WireLink::carry(const hal::SensorMessage& m, std::deque<hal::SensorMessage>& out) {
+void WireLink::carry(const hal::SensorMessage& m, std::deque<hal::SensorMessage>& out, TimeNs now) {
   std::visit(
-      [this](const auto& msg) {
+      [this, now](const auto& msg) {
         using T = std::decay_t<decltype(msg)>;
         if constexpr (std::is_same_v<T, hal::Imu>) {
-          for (const hal::CanFrame& f : vcu_.encode(msg)) carry_frame(f, acu_);
+          for (const hal::CanFrame& f : vcu_.encode(msg)) carry_frame(f, acu_, true, now);
         } else if constexpr (std::is_same_v<T, hal::WheelSpeeds> || std::is_same_v<T, hal::SteeringAngle> ||
                              std::is_same_v<T, hal::ResSignal>) {
-          carry_frame(vcu_.encode(msg), acu_);
+          carry_frame(vcu_.encode(msg), acu_, true, now);
         } else {
           throw std::logic_error("WireLink::carry: not a message of the CAN bus");
         }
@@ -48,9 +49,11 @@ void WireLink::carry(const hal::SensorMessage& m, std::deque<hal::SensorMessage>
   while (std::optional<hal::SensorMessage> d = acu_.pop_sensor()) out.push_back(std::move(*d));
 }
 
-void WireLink::carry_lidar(const std::vector<std::uint8_t>& packets, std::deque<hal::SensorMessage>& out) {
+void WireLink::carry_lidar(const std::vector<std::uint8_t>& packets, std::deque<hal::SensorMessage>& out,
+                           TimeNs now) {
   if (!decoder_) throw std::logic_error("WireLink::carry_lidar: no LiDAR metadata");
   for (std::size_t at = 0; at + packet_size_ <= packets.size(); at += packet_size_) {
+    if (tap_) tap_->lidar_packet(now, packets.data() + at, packet_size_);
     decoder_->push(packets.data() + at, packet_size_);
     ++counters_.lidar_packets;
     counters_.lidar_bytes += packet_size_;
@@ -58,8 +61,8 @@ void WireLink::carry_lidar(const std::vector<std::uint8_t>& packets, std::deque<
   while (std::optional<hal::LidarScan> s = decoder_->pop()) out.push_back(std::move(*s));
 }
 
-std::optional<hal::ActuatorCommand> WireLink::carry(const hal::ActuatorCommand& c) {
-  carry_frame(acu_.encode(c), vcu_);
+std::optional<hal::ActuatorCommand> WireLink::carry(const hal::ActuatorCommand& c, TimeNs now) {
+  carry_frame(acu_.encode(c), vcu_, false, now);
   std::optional<hal::ActuatorCommand> last;
   while (std::optional<hal::ActuatorCommand> d = vcu_.pop_command()) last = *d;
   return last;

@@ -32,6 +32,20 @@ struct WireCounters {
   hal::CarCanCounters vcu;               // the car's VCU (commands in)
 };
 
+// what watches the HAL's traffic (a run's log): the bytes on the wires, and
+// the messages that cross in memory, each at the instant it crossed
+class WireTap {
+ public:
+  virtual ~WireTap() = default;
+  // one UDP payload of the LiDAR
+  virtual void lidar_packet(TimeNs at, const std::uint8_t* data, std::size_t size) = 0;
+  // one CAN frame as struct can_frame: to the stack (the sensors) or from it (the command)
+  virtual void can_frame(TimeNs at, bool to_stack, const std::uint8_t* frame) = 0;
+  // a message that crosses the HAL as a struct (no wire carries it: the
+  // detector node's boxes, an object-level sensor's cones, the true state)
+  virtual void message(TimeNs at, const hal::SensorMessage& m) = 0;
+};
+
 class WireLink {
  public:
   // lidar: the LiDAR's metadata (none: no LiDAR on the wire) and layout, the
@@ -43,12 +57,14 @@ class WireLink {
   static bool on_can(const hal::SensorMessage& m);
   // m (on_can) through the bus: the VCU's frames as bytes, decoded by the
   // stack's side; what came out appended to `out`
-  void carry(const hal::SensorMessage& m, std::deque<hal::SensorMessage>& out);
+  void carry(const hal::SensorMessage& m, std::deque<hal::SensorMessage>& out, TimeNs now);
   // one rotation's packets, as the sensor sends them, into the car's decoder;
   // the scans it completed appended to `out`
-  void carry_lidar(const std::vector<std::uint8_t>& packets, std::deque<hal::SensorMessage>& out);
+  void carry_lidar(const std::vector<std::uint8_t>& packets, std::deque<hal::SensorMessage>& out, TimeNs now);
   // the stack's command through the bus to the VCU (nothing if it dropped it)
-  std::optional<hal::ActuatorCommand> carry(const hal::ActuatorCommand& c);
+  std::optional<hal::ActuatorCommand> carry(const hal::ActuatorCommand& c, TimeNs now);
+  // who sees the bytes (none: nobody)
+  void set_tap(WireTap* tap) { tap_ = tap; }
 
   // the rotation's packets from the simulated LiDAR's points (each with its
   // column and ring): frame `frame_id`, column c fired at column_time(c)
@@ -61,7 +77,7 @@ class WireLink {
   WireCounters counters() const;
 
  private:
-  void carry_frame(const hal::CanFrame& f, hal::CarCan& to);
+  void carry_frame(const hal::CanFrame& f, hal::CarCan& to, bool to_stack, TimeNs now);
 
   std::optional<hal::ouster::SensorInfo> info_;
   std::unique_ptr<hal::ouster::Decoder> decoder_;
@@ -70,6 +86,7 @@ class WireLink {
   hal::CarCan vcu_;  // the car: sends the sensors' frames, takes the command
   hal::CarCan acu_;  // the stack's computer: takes the sensors' frames, sends the command
   WireCounters counters_;
+  WireTap* tap_ = nullptr;
 };
 
 }  // namespace paddock::runner

@@ -1,0 +1,265 @@
+#include "sim/runner/replay.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "autonomy/hal/car_can.h"
+#include "autonomy/hal/hal.h"
+#include "autonomy/hal/ouster.h"
+#include "autonomy/log/mcap.h"
+#include "autonomy/stack/stack.h"
+#include "sim/runner/files.h"
+#include "sim/runner/model.h"
+#include "sim/runner/scenario.h"
+#include "sim/world/track.h"
+
+namespace paddock::runner {
+namespace {
+
+using nlohmann::json;
+
+// the car's side of the HAL on a log: what the decoders gave, the stack's command
+class ReplayHal final : public hal::Hal {
+ public:
+  std::deque<hal::SensorMessage> inbox;
+  std::optional<hal::ActuatorCommand> command;
+  std::optional<hal::SensorMessage> receive() override {
+    if (inbox.empty()) return std::nullopt;
+    hal::SensorMessage m = std::move(inbox.front());
+    inbox.pop_front();
+    return m;
+  }
+  void send(const hal::ActuatorCommand& c) override { command = c; }
+};
+
+std::string text_of(const std::vector<std::uint8_t>& d) { return std::string(d.begin(), d.end()); }
+
+// the messages that crossed the HAL as structs, back from their JSON
+hal::CameraDetections detections_of(const json& j) {
+  hal::CameraDetections d;
+  d.stamp = j.at("stamp").get<TimeNs>();
+  d.width = j.at("width").get<int>();
+  d.height = j.at("height").get<int>();
+  for (const json& b : j.at("boxes"))
+    d.boxes.push_back({b.at("x_min").get<double>(), b.at("y_min").get<double>(), b.at("x_max").get<double>(),
+                       b.at("y_max").get<double>(), static_cast<ConeColor>(b.at("color").get<int>()),
+                       b.at("confidence").get<double>()});
+  return d;
+}
+
+hal::ConeDetections cones_of(const json& j) {
+  hal::ConeDetections d;
+  d.stamp = j.at("stamp").get<TimeNs>();
+  for (const json& c : j.at("cones"))
+    d.cones.push_back({{c.at("x").get<double>(), c.at("y").get<double>()},
+                       static_cast<ConeColor>(c.at("color").get<int>()),
+                       c.at("colour_from_camera").get<bool>()});
+  for (const json& f : j.at("free_range"))
+    d.free_range.push_back(f.is_null() ? std::numeric_limits<float>::infinity() : f.get<float>());
+  return d;
+}
+
+hal::StateEstimate state_of(const json& j) {
+  hal::StateEstimate s;
+  s.stamp = j.at("stamp").get<TimeNs>();
+  s.pose = {j.at("x").get<double>(), j.at("y").get<double>(), j.at("yaw").get<double>()};
+  s.vx = j.at("vx").get<double>();
+  s.vy = j.at("vy").get<double>();
+  s.yaw_rate = j.at("yaw_rate").get<double>();
+  return s;
+}
+
+struct LoggedCommand {
+  double steering = 0.0, throttle = 0.0, brake = 0.0, yaw_moment = 0.0;
+  std::string as_state;
+};
+
+}  // namespace
+
+ReplayResult replay(const std::string& path, const ReplayOptions& o) {
+  const auto wall0 = std::chrono::steady_clock::now();
+  // the log and what it carries besides its messages
+  log::McapReader reader(std::make_unique<log::FileSource>(path));
+  std::map<std::string, std::string> files;
+  try {
+    reader.open();
+    for (const log::Attachment& a : reader.read_attachments()) files[a.name] = text_of(a.data);
+  } catch (const log::McapError& e) {
+    throw UserError(path + ": " + e.what());
+  }
+  for (const char* need : {"scenario.ini", "track.csv", "car.dbc"}) {
+    if (!files.count(need))
+      throw UserError(path + ": no attachment " + need + "; expected a log of `paddock run ... --log`");
+  }
+  // the scenario as the run resolved it, its files beside it, the user's changes last
+  namespace fs = std::filesystem;
+  const fs::path dir = o.extract_dir.empty()
+                           ? fs::temp_directory_path() / ("paddock_replay_" + std::to_string(::getpid()))
+                           : fs::path(o.extract_dir);
+  fs::create_directories(dir);
+  std::vector<std::string> overrides;
+  for (const auto& [name, text] : files) {
+    const std::string f = fs::absolute(dir / name).string();
+    write_file_atomic(f, text);
+    if (name == "track.csv") overrides.push_back("scenario.track=" + f);
+    if (name == "car.dbc") overrides.push_back("hal.dbc=" + f);
+    if (name == "lidar_metadata.json") overrides.push_back("hal.lidar_metadata=" + f);
+  }
+  overrides.insert(overrides.end(), o.overrides.begin(), o.overrides.end());
+  const Scenario scenario = load_scenario((dir / "scenario.ini").string(), overrides);
+  const world::TrackModel track = world::build_track(load_track_file(scenario.track_path));
+  const SimModel model = compile_model(scenario, track);
+
+  // the car: its decoders and its stack
+  stack::Stack stack(model.stack, model.mission);
+  ReplayHal hal;
+  std::unique_ptr<hal::ouster::Decoder> lidar;
+  if (scenario.lidar_info) lidar = std::make_unique<hal::ouster::Decoder>(*scenario.lidar_info, scenario.lidar);
+  hal::CarCan can(*scenario.dbc, scenario.hal.dbc);
+
+  // the channels by topic
+  enum Kind { kOther, kPackets, kCanRx, kDetections, kCones, kState, kCommand };
+  std::map<std::uint16_t, Kind> kind;
+  for (const auto& [id, ch] : reader.channels()) {
+    const std::string& t = ch.topic;
+    kind[id] = t == "/lidar/packets" ? kPackets
+               : t == "/can/rx"      ? kCanRx
+               : t == "/hal/detections" ? kDetections
+               : t == "/hal/cones"   ? kCones
+               : t == "/hal/state"   ? kState
+               : t == "/stack/command" ? kCommand
+                                       : kOther;
+  }
+
+  ReplayResult r;
+  const TimeNs period = model.dt_ns * model.every.control;
+  const TimeNs from = o.from ? from_seconds(*o.from) : 0;
+  const TimeNs until = o.until ? from_seconds(*o.until) : std::numeric_limits<TimeNs>::max();
+  TimeNs tick = (from + period - 1) / period * period;  // the first control cycle at or after --from
+  std::map<TimeNs, LoggedCommand> logged;
+  // the control cycle at `tick`: the stack, its command against the live one
+  const auto cycle = [&]() {
+    hal.command.reset();
+    stack.tick(tick, hal);
+    ++r.cycles;
+    const auto it = logged.find(tick);
+    if (it != logged.end() && hal.command) {
+      const hal::ActuatorCommand& c = *hal.command;
+      const LoggedCommand& l = it->second;
+      ++r.compared;
+      const bool same = c.steering_angle == l.steering && c.throttle == l.throttle && c.brake == l.brake &&
+                        c.yaw_moment == l.yaw_moment && hal::to_string(c.as_state) == l.as_state;
+      if (same) {
+        ++r.identical;
+      } else if (!r.first_difference) {
+        r.first_difference = to_seconds(tick);
+      }
+      r.max_steering_difference = std::max(r.max_steering_difference, std::abs(c.steering_angle - l.steering));
+      r.max_throttle_difference = std::max(r.max_throttle_difference, std::abs(c.throttle - l.throttle));
+      r.max_brake_difference = std::max(r.max_brake_difference, std::abs(c.brake - l.brake));
+      if (hal::to_string(c.as_state) != l.as_state) ++r.as_state_differences;
+      logged.erase(logged.begin(), std::next(it));
+    }
+    if (hal.command) r.final_as_state = hal::to_string(hal.command->as_state);
+    tick += period;
+  };
+
+  try {
+    log::ReadOptions ro;
+    ro.start = static_cast<std::uint64_t>(from);
+    log::McapReader::Messages messages = reader.messages(ro);
+    log::Message m;
+    while (messages.next(m)) {
+      const auto at = static_cast<TimeNs>(m.log_time);
+      if (at > until) break;
+      // the cycles before this message
+      while (tick < at && tick <= until) cycle();
+      const Kind k = kind.count(m.channel_id) ? kind[m.channel_id] : kOther;
+      switch (k) {
+        case kPackets:
+          if (lidar) {
+            lidar->push(m.data, m.size);
+            while (std::optional<hal::LidarScan> s = lidar->pop()) {
+              hal.inbox.push_back(std::move(*s));
+              ++r.lidar_scans;
+            }
+          }
+          break;
+        case kCanRx:
+          if (const std::optional<hal::CanFrame> f = hal::from_socketcan(m.data, m.size, at)) {
+            can.push(*f);
+            ++r.can_frames;
+            while (std::optional<hal::SensorMessage> s = can.pop_sensor()) hal.inbox.push_back(std::move(*s));
+          }
+          break;
+        case kDetections:
+        case kCones:
+        case kState: {
+          const json j = json::parse(m.data, m.data + m.size);
+          if (k == kDetections) hal.inbox.push_back(detections_of(j));
+          if (k == kCones) hal.inbox.push_back(cones_of(j));
+          if (k == kState) hal.inbox.push_back(state_of(j));
+          ++r.struct_messages;
+          break;
+        }
+        case kCommand: {
+          const json j = json::parse(m.data, m.data + m.size);
+          logged[at] = {j.at("steering_angle").get<double>(), j.at("throttle").get<double>(),
+                        j.at("brake").get<double>(), j.at("yaw_moment").get<double>(),
+                        j.at("as_state").get<std::string>()};
+          break;
+        }
+        case kOther:
+          break;
+      }
+      r.log_time = to_seconds(at);
+    }
+    // the cycles up to the last message's instant
+    while (tick <= from_seconds(r.log_time) && tick <= until) cycle();
+  } catch (const log::McapError& e) {
+    throw UserError(path + ": " + e.what());
+  } catch (const json::exception& e) {
+    throw UserError(path + ": a message that is no paddock JSON: " + e.what());
+  }
+  r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return r;
+}
+
+std::string replay_text(const std::string& path, const ReplayResult& r) {
+  std::ostringstream o;
+  char buf[256];
+  o << "replay " << path << "\n";
+  std::snprintf(buf, sizeof buf, "  log         %.3f s: %ld LiDAR scans, %ld CAN frames, %ld HAL messages\n",
+                r.log_time, r.lidar_scans, r.can_frames, r.struct_messages);
+  o << buf;
+  std::snprintf(buf, sizeof buf, "  stack       %ld control cycles, final AS state %s\n", r.cycles,
+                r.final_as_state.empty() ? "-" : r.final_as_state.c_str());
+  o << buf;
+  if (r.compared == r.identical) {
+    std::snprintf(buf, sizeof buf, "  commands    %ld compared with the log: all identical, bit for bit\n", r.compared);
+    o << buf;
+  } else {
+    std::snprintf(buf, sizeof buf,
+                  "  commands    %ld compared with the log: %ld identical; the first difference at %.3f s\n"
+                  "              largest differences: steering %.4f rad, throttle %.4f, brake %.4f; AS state in %ld cycles\n",
+                  r.compared, r.identical, r.first_difference.value_or(0.0), r.max_steering_difference,
+                  r.max_throttle_difference, r.max_brake_difference, r.as_state_differences);
+    o << buf;
+  }
+  std::snprintf(buf, sizeof buf, "  speed       %.1f s of log in %.3f s (%.0fx real time)\n", r.log_time, r.wall_time,
+                r.wall_time > 0 ? r.log_time / r.wall_time : 0.0);
+  o << buf;
+  return o.str();
+}
+
+}  // namespace paddock::runner

@@ -1,0 +1,125 @@
+// a run's log (paddock run ... --log: run.mcap) and its replay (paddock
+// replay): the official MCAP reader reads the log whole, with every topic a
+// team opens in Foxglove; the replay, with no simulator, hands the stack the
+// recorded packets and frames through the car's decoders and gets the live
+// run's commands to the bit; a changed stack (--set) is told where it
+// differs; a file that is no log, or a cut one, is a clear error
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "autonomy/log/mcap.h"
+#include "tests/runner/run_paddock.h"
+
+namespace paddock::runner {
+namespace {
+
+namespace fs = std::filesystem;
+const std::string kRoot = PADDOCK_SOURCE_DIR;
+
+// the wire autocross cut 7 s after the go (at 5 s), logged once
+const fs::path& logged_run() {
+  static const fs::path dir = [] {
+    const fs::path d = fs::temp_directory_path() / "paddock_run_log_test";
+    fs::remove_all(d);
+    const testing::Outcome o = testing::run_paddock("run " + kRoot + "/scenarios/fsg_2023_autocross_wire.ini" +
+                                                    " --set event.timeout=7 --log --quiet --out " + d.string());
+    EXPECT_TRUE(fs::exists(d / "run.mcap")) << o.output;
+    return d;
+  }();
+  return dir;
+}
+
+TEST(RunLog, TheOfficialReaderReadsTheRunsLogWithEveryTopic) {
+  const fs::path log = logged_run() / "run.mcap";
+  ASSERT_TRUE(fs::exists(log));
+  const std::string modules = (fs::current_path() / "mcap-validator" / "node_modules").string();
+  ASSERT_TRUE(fs::exists(fs::path(modules) / "@mcap" / "core"))
+      << "the official MCAP reader is needed: run ./paddock test, which installs it into <build>/mcap-validator";
+  const testing::Outcome o = testing::run_paddock_command("NODE_PATH='" + modules + "' node '" + kRoot +
+                                                          "/tests/log/validate_mcap.mjs' '" + log.string() + "' 2>&1");
+  ASSERT_EQ(o.code, 0) << o.output;
+  const nlohmann::json j = nlohmann::json::parse(o.output);
+  const nlohmann::json& topics = j.at("topics");
+  // what the run lasted (its summary): the messages each sensor and cycle makes in that time
+  std::ifstream summary(logged_run() / "summary.json");
+  const double t = nlohmann::json::parse(summary).at("sim_time").get<double>();
+  const long cycles = std::lround(t * 100.0) + 1, rotations = std::lround(std::floor(t * 10.0 + 1e-9));
+  EXPECT_GT(t, 11.9);
+  EXPECT_EQ(j.at("last_log_time").get<double>(), std::round(t * 1e9));
+  // 64 packets a rotation; a cloud every fifth; a command and its frame each cycle
+  EXPECT_EQ(topics.at("/lidar/packets").get<long>(), 64 * rotations);
+  EXPECT_EQ(topics.at("/lidar/points").get<long>(), (rotations + 4) / 5);
+  EXPECT_EQ(topics.at("/stack/command").get<long>(), cycles);
+  EXPECT_EQ(topics.at("/can/tx").get<long>(), cycles);
+  // the IMU's two frames at 200 Hz, wheels and steering at 100 Hz, the RES's go
+  EXPECT_EQ(topics.at("/can/rx").get<long>(), 2 * (2 * cycles - 1) + cycles + cycles + 1);
+  EXPECT_EQ(topics.at("/hal/detections").get<long>(), rotations);
+  for (const char* topic : {"/tf", "/stack/pose", "/truth/pose", "/stack/map", "/stack/path", "/truth/cones"})
+    EXPECT_GT(topics.at(topic).get<long>(), 0) << topic;
+  for (const char* s : {"foxglove.FrameTransform", "foxglove.PoseInFrame", "foxglove.SceneUpdate", "foxglove.PointCloud"}) {
+    bool found = false;
+    for (const auto& name : j.at("schemas")) found = found || name.get<std::string>() == s;
+    EXPECT_TRUE(found) << s;
+  }
+  // our own reader: the attachments a replay needs
+  log::McapReader reader(std::make_unique<log::FileSource>(log.string()));
+  reader.open();
+  std::map<std::string, std::size_t> attached;
+  for (const log::Attachment& a : reader.read_attachments()) attached[a.name] = a.data.size();
+  for (const char* n : {"scenario.ini", "track.csv", "car.dbc", "lidar_metadata.json"}) EXPECT_GT(attached[n], 0u) << n;
+}
+
+TEST(RunLog, TheReplayGivesTheLiveRunsCommandsBitForBit) {
+  const fs::path log = logged_run() / "run.mcap";
+  const testing::Outcome same = testing::run_paddock("replay " + log.string());
+  ASSERT_EQ(same.code, 0) << same.output;
+  EXPECT_NE(same.output.find("compared with the log: all identical, bit for bit"), std::string::npos)
+      << same.output;
+  EXPECT_NE(same.output.find("final AS state driving"), std::string::npos) << same.output;
+  // a changed stack on the same log: it steers otherwise from the go on
+  const testing::Outcome changed = testing::run_paddock("replay " + log.string() + " --set control.stanley.k=3");
+  ASSERT_EQ(changed.code, 0) << changed.output;
+  EXPECT_NE(changed.output.find("the first difference at 5.000 s"), std::string::npos) << changed.output;
+  // a window: the first 6 s only
+  const testing::Outcome head = testing::run_paddock("replay " + log.string() + " --until 6");
+  EXPECT_NE(head.output.find("601 compared with the log: all identical"), std::string::npos) << head.output;
+}
+
+TEST(RunLog, ALogNeedsTheWireAndAReplayNeedsALog) {
+  const testing::Outcome memory = testing::run_paddock("run " + kRoot + "/scenarios/fsg_2023_autocross.ini --log --out " +
+                                                       (fs::temp_directory_path() / "paddock_no_wire").string());
+  EXPECT_EQ(memory.code, 2);
+  EXPECT_NE(memory.output.find("--log records the car's wires: it needs [hal] transport = wire"), std::string::npos)
+      << memory.output;
+  const testing::Outcome not_mcap = testing::run_paddock("replay " + kRoot + "/scenarios/sensors/paddock.dbc");
+  EXPECT_EQ(not_mcap.code, 2);
+  EXPECT_NE(not_mcap.output.find("paddock.dbc: mcap: byte 0: expected the Magic"), std::string::npos) << not_mcap.output;
+  // cut short: the missing summary named, nothing replayed
+  const fs::path cut = fs::temp_directory_path() / "paddock_cut.mcap";
+  {
+    std::FILE* in = std::fopen((logged_run() / "run.mcap").c_str(), "rb");
+    std::FILE* out = std::fopen(cut.c_str(), "wb");
+    ASSERT_TRUE(in && out);
+    char buf[65536];
+    const std::size_t n = std::fread(buf, 1, sizeof buf, in);
+    std::fwrite(buf, 1, n, out);
+    std::fclose(in);
+    std::fclose(out);
+  }
+  const testing::Outcome short_log = testing::run_paddock("replay " + cut.string());
+  EXPECT_EQ(short_log.code, 2);
+  EXPECT_NE(short_log.output.find("cut short or damaged"), std::string::npos) << short_log.output;
+  const testing::Outcome bad_time = testing::run_paddock("replay " + cut.string() + " --from -3");
+  EXPECT_NE(bad_time.output.find("--from -3: expected a time in seconds >= 0"), std::string::npos) << bad_time.output;
+}
+
+}  // namespace
+}  // namespace paddock::runner
