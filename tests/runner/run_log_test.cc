@@ -5,6 +5,7 @@
 // run's commands to the bit; a changed stack (--set) is told where it
 // differs; a file that is no log, or a cut one, is a clear error
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdio>
@@ -12,6 +13,7 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -24,10 +26,11 @@ namespace {
 namespace fs = std::filesystem;
 const std::string kRoot = PADDOCK_SOURCE_DIR;
 
-// the wire autocross cut 7 s after the go (at 5 s), logged once
+// the wire autocross cut 7 s after the go (at 5 s), logged once per test
+// process (ctest runs the tests as processes side by side: each its own)
 const fs::path& logged_run() {
   static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / "paddock_run_log_test";
+    const fs::path d = fs::temp_directory_path() / ("paddock_run_log_test_" + std::to_string(::getpid()));
     fs::remove_all(d);
     const testing::Outcome o = testing::run_paddock("run " + kRoot + "/scenarios/fsg_2023_autocross_wire.ini" +
                                                     " --set event.timeout=7 --log --quiet --out " + d.string());
@@ -102,16 +105,18 @@ TEST(RunLog, ALogNeedsTheWireAndAReplayNeedsALog) {
   const testing::Outcome not_mcap = testing::run_paddock("replay " + kRoot + "/scenarios/sensors/paddock.dbc");
   EXPECT_EQ(not_mcap.code, 2);
   EXPECT_NE(not_mcap.output.find("paddock.dbc: mcap: byte 0: expected the Magic"), std::string::npos) << not_mcap.output;
-  // cut short: the missing summary named, nothing replayed
-  const fs::path cut = fs::temp_directory_path() / "paddock_cut.mcap";
+  // cut short (an MCAP file without its summary): the byte named, nothing replayed
+  const fs::path cut = fs::temp_directory_path() / ("paddock_cut_" + std::to_string(::getpid()) + ".mcap");
   {
-    std::FILE* in = std::fopen((logged_run() / "run.mcap").c_str(), "rb");
+    std::vector<std::uint8_t> bytes;
+    log::McapWriter w(std::make_unique<log::MemorySink>(bytes));
+    const std::uint16_t ch = w.add_channel(0, "/can/rx", "socketcan.can_frame");
+    const std::uint8_t frame[16] = {};
+    for (std::uint32_t i = 0; i < 100; ++i) w.write(ch, i, 1000u * i, 1000u * i, frame, sizeof frame);
+    w.close();
     std::FILE* out = std::fopen(cut.c_str(), "wb");
-    ASSERT_TRUE(in && out);
-    char buf[65536];
-    const std::size_t n = std::fread(buf, 1, sizeof buf, in);
-    std::fwrite(buf, 1, n, out);
-    std::fclose(in);
+    ASSERT_TRUE(out);
+    std::fwrite(bytes.data(), 1, bytes.size() / 2, out);
     std::fclose(out);
   }
   const testing::Outcome short_log = testing::run_paddock("replay " + cut.string());
