@@ -105,11 +105,14 @@ json stamp_of(TimeNs t) {
 }
 
 json position(double x, double y, double z) { return {{"x", x}, {"y", y}, {"z", z}}; }
-json yaw_rotation(double yaw) {
-  return {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(0.5 * yaw)}, {"w", std::cos(0.5 * yaw)}};
+// yaw about z, then pitch about the new y: q = q_z(yaw) q_y(pitch)
+json rotation(double yaw, double pitch = 0.0) {
+  const double cy = std::cos(0.5 * yaw), sy = std::sin(0.5 * yaw), cp = std::cos(0.5 * pitch),
+               sp = std::sin(0.5 * pitch);
+  return {{"x", -sy * sp}, {"y", cy * sp}, {"z", sy * cp}, {"w", cy * cp}};
 }
 json pose_json(double x, double y, double z, double yaw) {
-  return {{"position", position(x, y, z)}, {"orientation", yaw_rotation(yaw)}};
+  return {{"position", position(x, y, z)}, {"orientation", rotation(yaw)}};
 }
 json rgba(double r, double g, double b, double a = 1.0) { return {{"r", r}, {"g", g}, {"b", b}, {"a", a}}; }
 
@@ -144,14 +147,11 @@ json cones_update(const std::vector<Cone>& cones, TimeNs at, const char* id) {
 
 json transform(TimeNs at, const char* parent, const char* child, double x, double y, double z, double yaw,
                double pitch = 0.0) {
-  // yaw about z, then pitch about the new y: q = q_z(yaw) q_y(pitch)
-  const double cy = std::cos(0.5 * yaw), sy = std::sin(0.5 * yaw), cp = std::cos(0.5 * pitch),
-               sp = std::sin(0.5 * pitch);
   return {{"timestamp", stamp_of(at)},
           {"parent_frame_id", parent},
           {"child_frame_id", child},
           {"translation", position(x, y, z)},
-          {"rotation", {{"x", -sy * sp}, {"y", cy * sp}, {"z", sy * cp}, {"w", cy * cp}}}};
+          {"rotation", rotation(yaw, pitch)}};
 }
 
 // RFC 4648 base64 (what a JSON `bytes` field holds)
@@ -198,8 +198,7 @@ RunLog::RunLog(const std::string& path, const Scenario& sc) {
     info_ = sc.lidar_info;
     decoder_ = std::make_unique<hal::ouster::Decoder>(*info_, sc.lidar);
   }
-  const std::string dbc = read_file(sc.hal.dbc);
-  mcap_->write_attachment({0, 0, "car.dbc", "text/plain", std::vector<std::uint8_t>(dbc.begin(), dbc.end())});
+  mcap_->write_attachment({0, 0, "car.dbc", "text/plain", std::vector<std::uint8_t>(sc.dbc_text.begin(), sc.dbc_text.end())});
   const std::string track = read_file(sc.track_path);
   mcap_->write_attachment({0, 0, "track.csv", "text/csv", std::vector<std::uint8_t>(track.begin(), track.end())});
   const std::string resolved = resolved_ini(sc);
@@ -403,6 +402,5 @@ void RunLog::observe(const SimModel& model, SimState& s) {
 
 void RunLog::close() { mcap_->close(); }
 
-std::uint64_t RunLog::bytes_written() const { return mcap_->bytes_written(); }
 
 }  // namespace paddock::runner

@@ -55,7 +55,6 @@ class RunLog final : public Observer, public WireTap {
 
   // finishes the file (summary, footer) and puts it in place
   void close();
-  std::uint64_t bytes_written() const;
 
  private:
   std::uint16_t channel(const std::string& topic, const std::string& schema, const std::string& encoding);

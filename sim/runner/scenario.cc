@@ -214,7 +214,8 @@ void load_hal_files(Scenario& s, const std::vector<IniEntry>& entries, const std
   if (!s.hal.dbc.empty()) {
     const std::string& file = s.hal.dbc;
     try {
-      s.dbc = std::make_shared<const hal::Dbc>(hal::parse_dbc(read_file(file), file));
+      s.dbc_text = read_file(file);
+      s.dbc = std::make_shared<const hal::Dbc>(hal::parse_dbc(s.dbc_text, file));
       // the car's frames must all be there (throws naming what is missing)
       const hal::CarCan check(*s.dbc, file);
     } catch (const std::invalid_argument& e) {

@@ -149,6 +149,7 @@ struct Scenario {
   // what the [hal] files say, read and checked at load (none when unnamed)
   std::optional<hal::ouster::SensorInfo> lidar_info;
   std::shared_ptr<const hal::Dbc> dbc;
+  std::string dbc_text;  // the DBC file as read (a run's log carries it)
 
   ScenarioSection scenario;
   stack::AutonomyModes autonomy;
