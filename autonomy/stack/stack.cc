@@ -383,6 +383,11 @@ hal::ActuatorCommand Stack::safe_stop(TimeNs now, const std::string& reason) {
   return cmd;
 }
 
+void Stack::emergency(const std::string& reason) {
+  emergency_ = true;
+  telemetry_.last_fault = reason;
+}
+
 void Stack::tick(TimeNs now, hal::Hal& hal) {
   while (auto m = hal.receive()) on_message(std::move(*m));
   // frames that came before the state estimate of their instant

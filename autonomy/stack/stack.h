@@ -199,6 +199,10 @@ class Stack {
   // drains the HAL's messages, plans when there is news, runs one control
   // cycle, sends one command
   void tick(TimeNs now, hal::Hal& hal);
+  // AS Emergency from the next cycle on, latched as the RES's emergency is
+  // (the car binary's watchdogs: a sensor went silent); `reason` becomes the
+  // last fault
+  void emergency(const std::string& reason);
 
   const Telemetry& telemetry() const { return telemetry_; }
   const Trajectory& trajectory() const { return trajectory_; }

@@ -1,6 +1,9 @@
 #include "sim/runner/cli.h"
 
+#include <signal.h>
+
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -43,6 +46,12 @@ const char* kUsage =
     "      reruns the stack on a run's log (paddock run ... --log) without the simulator:\n"
     "      the recorded packets and frames through the car's decoders. Unchanged it gives\n"
     "      the live run's commands bit for bit; with --set it says where they differ.\n"
+    "  paddock car SCENARIO.ini [--set section.key=value]...\n"
+    "      the car binary: the scenario's stack alone behind the car's sockets ([car]:\n"
+    "      the LiDAR's UDP packets, the CAN bus by SocketCAN or CAN over UDP, the\n"
+    "      detector node's boxes), with its watchdogs. clock = lockstep runs with\n"
+    "      paddock run ... --set hal.transport=udp (software in the loop); clock = wall\n"
+    "      runs on the car. Stops at the simulator's end, or on SIGINT/SIGTERM\n"
     "  paddock sweep SWEEP.ini [--jobs N] [--out DIR] [--resume] [--shard i/n] [--plots]\n"
     "      runs a sweep's points (scenarios x [vary] values x seeds) on N cores (default:\n"
     "      all) into DIR (default runs/<sweep name>): DIR/points/NNNN/{scenario.ini,\n"
@@ -461,6 +470,60 @@ int cmd_replay(const std::vector<std::string>& args) {
   return 0;
 }
 
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_stop_signal(int) { g_stop = 1; }
+
+// car SCENARIO.ini [--set k=v]...
+int cmd_car(const std::vector<std::string>& args) {
+  std::string path;
+  std::vector<std::string> overrides;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--set") {
+      if (i + 1 >= args.size()) throw UserError("--set needs a value");
+      overrides.push_back(args[++i]);
+    } else if (a.rfind("--set=", 0) == 0) {
+      overrides.push_back(a.substr(6));
+    } else if (!a.empty() && a[0] == '-') {
+      throw UserError("car: unknown option " + a + "\n" + kUsage);
+    } else if (path.empty()) {
+      path = a;
+    } else {
+      throw UserError("car: more than one scenario given: " + path + " and " + a);
+    }
+  }
+  if (path.empty()) throw UserError(std::string("car needs a scenario (the stack's parameters, [hal] and [car])\n") + kUsage);
+  const Scenario scenario = load_scenario(path, overrides);
+  if (!scenario.dbc)
+    throw UserError(scenario.source + ": the car binary reads the car's CAN bus: [hal] dbc must name its DBC file (include = sensors/ouster.ini)");
+  const bool lidar = scenario.autonomy.perception != stack::PerceptionMode::GroundTruth;
+  if (lidar && !scenario.lidar_info)
+    throw UserError(scenario.source + ": the car binary decodes the LiDAR's packets: [hal] lidar_metadata must name its metadata file (include = sensors/ouster.ini)");
+  // the track gives the mission the car's grid position (the origin of its map)
+  const world::TrackModel track = world::build_track(load_track_file(scenario.track_path));
+  const SimModel model = compile_model(scenario, track);
+  car::CarSetup setup;
+  setup.stack = model.stack;
+  setup.mission = model.mission;
+  if (lidar) setup.lidar = scenario.lidar_info;
+  setup.layout = scenario.lidar;
+  setup.dbc = scenario.dbc.get();
+  setup.dbc_source = scenario.hal.dbc;
+  setup.car = scenario.car;
+  setup.control_period = model.dt_ns * model.every.control;
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  try {
+    car::run_car(setup, std::cout, &g_stop);
+  } catch (const std::runtime_error& e) {
+    throw UserError(std::string("car: ") + e.what());
+  }
+  return 0;
+}
+
 int cmd_check_track(const std::vector<std::string>& args) {
   if (args.empty()) throw UserError(std::string("check-track needs at least one file\n") + kUsage);
   int bad = 0;
@@ -489,6 +552,7 @@ int run_cli(const std::vector<std::string>& args) {
     if (args[0] == "run") return cmd_run(rest);
     if (args[0] == "check-track") return cmd_check_track(rest);
     if (args[0] == "replay") return cmd_replay(rest);
+    if (args[0] == "car") return cmd_car(rest);
     if (args[0] == "plot") return cmd_plot(rest);
     if (args[0] == "sweep") return cmd_sweep(rest);
     if (args[0] == "tune") return cmd_tune(rest);

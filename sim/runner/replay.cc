@@ -13,8 +13,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include "autonomy/car/car_node.h"
 #include "autonomy/hal/car_can.h"
 #include "autonomy/hal/hal.h"
+#include "autonomy/hal/json.h"
 #include "autonomy/hal/ouster.h"
 #include "autonomy/log/mcap.h"
 #include "autonomy/stack/stack.h"
@@ -28,56 +30,7 @@ namespace {
 
 using nlohmann::json;
 
-// the car's side of the HAL on a log: what the decoders gave, the stack's command
-class ReplayHal final : public hal::Hal {
- public:
-  std::deque<hal::SensorMessage> inbox;
-  std::optional<hal::ActuatorCommand> command;
-  std::optional<hal::SensorMessage> receive() override {
-    if (inbox.empty()) return std::nullopt;
-    hal::SensorMessage m = std::move(inbox.front());
-    inbox.pop_front();
-    return m;
-  }
-  void send(const hal::ActuatorCommand& c) override { command = c; }
-};
-
 std::string text_of(const std::vector<std::uint8_t>& d) { return std::string(d.begin(), d.end()); }
-
-// the messages that crossed the HAL as structs, back from their JSON
-hal::CameraDetections detections_of(const json& j) {
-  hal::CameraDetections d;
-  d.stamp = j.at("stamp").get<TimeNs>();
-  d.width = j.at("width").get<int>();
-  d.height = j.at("height").get<int>();
-  for (const json& b : j.at("boxes"))
-    d.boxes.push_back({b.at("x_min").get<double>(), b.at("y_min").get<double>(), b.at("x_max").get<double>(),
-                       b.at("y_max").get<double>(), static_cast<ConeColor>(b.at("color").get<int>()),
-                       b.at("confidence").get<double>()});
-  return d;
-}
-
-hal::ConeDetections cones_of(const json& j) {
-  hal::ConeDetections d;
-  d.stamp = j.at("stamp").get<TimeNs>();
-  for (const json& c : j.at("cones"))
-    d.cones.push_back({{c.at("x").get<double>(), c.at("y").get<double>()},
-                       static_cast<ConeColor>(c.at("color").get<int>()),
-                       c.at("colour_from_camera").get<bool>()});
-  for (const json& f : j.at("free_range"))
-    d.free_range.push_back(f.is_null() ? std::numeric_limits<float>::infinity() : f.get<float>());
-  return d;
-}
-
-hal::StateEstimate state_of(const json& j) {
-  hal::StateEstimate s;
-  s.stamp = j.at("stamp").get<TimeNs>();
-  s.pose = {j.at("x").get<double>(), j.at("y").get<double>(), j.at("yaw").get<double>()};
-  s.vx = j.at("vx").get<double>();
-  s.vy = j.at("vy").get<double>();
-  s.yaw_rate = j.at("yaw_rate").get<double>();
-  return s;
-}
 
 struct LoggedCommand {
   double steering = 0.0, throttle = 0.0, brake = 0.0, yaw_moment = 0.0;
@@ -120,12 +73,9 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
   const world::TrackModel track = world::build_track(load_track_file(scenario.track_path));
   const SimModel model = compile_model(scenario, track);
 
-  // the car: its decoders and its stack
-  stack::Stack stack(model.stack, model.mission);
-  ReplayHal hal;
-  std::unique_ptr<hal::ouster::Decoder> lidar;
-  if (scenario.lidar_info) lidar = std::make_unique<hal::ouster::Decoder>(*scenario.lidar_info, scenario.lidar);
-  hal::CarCan can(*scenario.dbc, scenario.hal.dbc);
+  // the car: its decoders, its stack and its watchdogs, as the car binary has them
+  car::CarNode node(model.stack, model.mission, scenario.lidar_info, scenario.lidar, *scenario.dbc, scenario.hal.dbc,
+                    scenario.car.watchdog);
 
   // the channels by topic
   enum Kind { kOther, kPackets, kCanRx, kDetections, kCones, kState, kCommand };
@@ -149,12 +99,10 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
   std::map<TimeNs, LoggedCommand> logged;
   // the control cycle at `tick`: the stack, its command against the live one
   const auto cycle = [&]() {
-    hal.command.reset();
-    stack.tick(tick, hal);
+    const hal::ActuatorCommand c = node.tick(tick);
     ++r.cycles;
     const auto it = logged.find(tick);
-    if (it != logged.end() && hal.command) {
-      const hal::ActuatorCommand& c = *hal.command;
+    if (it != logged.end()) {
       const LoggedCommand& l = it->second;
       ++r.compared;
       const bool same = c.steering_angle == l.steering && c.throttle == l.throttle && c.brake == l.brake &&
@@ -170,7 +118,7 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
       if (hal::to_string(c.as_state) != l.as_state) ++r.as_state_differences;
       logged.erase(logged.begin(), std::next(it));
     }
-    if (hal.command) r.final_as_state = hal::to_string(hal.command->as_state);
+    r.final_as_state = hal::to_string(c.as_state);
     tick += period;
   };
 
@@ -187,28 +135,22 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
       const Kind k = kind.count(m.channel_id) ? kind[m.channel_id] : kOther;
       switch (k) {
         case kPackets:
-          if (lidar) {
-            lidar->push(m.data, m.size);
-            while (std::optional<hal::LidarScan> s = lidar->pop()) {
-              hal.inbox.push_back(std::move(*s));
-              ++r.lidar_scans;
-            }
-          }
+          node.lidar_packet(at, m.data, m.size);
           break;
         case kCanRx:
           if (const std::optional<hal::CanFrame> f = hal::from_socketcan(m.data, m.size, at)) {
-            can.push(*f);
+            node.can_frame(*f);
             ++r.can_frames;
-            while (std::optional<hal::SensorMessage> s = can.pop_sensor()) hal.inbox.push_back(std::move(*s));
           }
           break;
         case kDetections:
         case kCones:
         case kState: {
-          const json j = json::parse(m.data, m.data + m.size);
-          if (k == kDetections) hal.inbox.push_back(detections_of(j));
-          if (k == kCones) hal.inbox.push_back(cones_of(j));
-          if (k == kState) hal.inbox.push_back(state_of(j));
+          const std::uint64_t bad = node.counters().bad_objects;
+          node.object(at, reinterpret_cast<const char*>(m.data), m.size);
+          if (node.counters().bad_objects != bad)
+            throw UserError(path + ": a message at " + std::to_string(to_seconds(at)) +
+                            " s that is no paddock JSON: " + node.last_bad_object());
           ++r.struct_messages;
           break;
         }
@@ -231,6 +173,8 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
   } catch (const json::exception& e) {
     throw UserError(path + ": a message that is no paddock JSON: " + e.what());
   }
+  r.lidar_scans = static_cast<long>(node.counters().lidar.rotations);
+  r.watchdog_fault = node.watchdog_fault().value_or("");
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   return r;
 }
@@ -256,6 +200,7 @@ std::string replay_text(const std::string& path, const ReplayResult& r) {
                   r.max_throttle_difference, r.max_brake_difference, r.as_state_differences);
     o << buf;
   }
+  if (!r.watchdog_fault.empty()) o << "  watchdog    " << r.watchdog_fault << "\n";
   std::snprintf(buf, sizeof buf, "  speed       %.1f s of log in %.3f s (%.0fx real time)\n", r.log_time, r.wall_time,
                 r.wall_time > 0 ? r.log_time / r.wall_time : 0.0);
   o << buf;

@@ -4,7 +4,8 @@
 // to the stack) go through the car's decoders, and the messages that crossed
 // the HAL as structs (the detector node's boxes) are read back, each handed
 // to the stack at the control cycle it reached it in the live run; the stack
-// is built from the log's own scenario (an attachment, with the track, the
+// is the car binary's (car::CarNode: its decoders and watchdogs), built
+// from the log's own scenario (an attachment, with the track, the
 // LiDAR's metadata and the DBC). Unchanged, it gives the live run's commands
 // to the bit; with --set it reruns a changed stack on the same log and says
 // where and how much its commands differ (the way a team debugs a real
@@ -33,6 +34,7 @@ struct ReplayResult {
   double max_brake_difference = 0.0;       // -
   long as_state_differences = 0;
   std::string final_as_state;              // the replayed stack's at the end
+  std::string watchdog_fault;              // why a watchdog of the car fired, if one did
   long lidar_scans = 0, can_frames = 0, struct_messages = 0;
   double log_time = 0.0;   // s of log replayed
   double wall_time = 0.0;  // s

@@ -2,11 +2,11 @@
 
 #include <cmath>
 #include <cstring>
-#include <type_traits>
 #include <variant>
 
 #include <nlohmann/json.hpp>
 
+#include "autonomy/hal/json.h"
 #include "sim/runner/files.h"
 #include "sim/runner/scenario.h"
 #include "sim/runner/simulation.h"
@@ -180,8 +180,8 @@ std::string base64(const std::uint8_t* p, std::size_t n) {
 }  // namespace
 
 RunLog::RunLog(const std::string& path, const Scenario& sc) {
-  if (sc.hal.transport != Transport::Wire)
-    throw UserError(sc.source + ": --log records the car's wires: it needs [hal] transport = wire (include = sensors/ouster.ini names the sensors' files; scenarios/fsg_2023_autocross_wire.ini is an example)");
+  if (sc.hal.transport == Transport::Memory)
+    throw UserError(sc.source + ": --log records the car's wires: it needs [hal] transport = wire (or udp) (include = sensors/ouster.ini names the sensors' files; scenarios/fsg_2023_autocross_wire.ini is an example)");
   log::McapWriterOptions o;
   o.profile = "";
   o.library = "paddock";
@@ -204,7 +204,7 @@ RunLog::RunLog(const std::string& path, const Scenario& sc) {
   const std::string resolved = resolved_ini(sc);
   mcap_->write_attachment({0, 0, "scenario.ini", "text/plain", std::vector<std::uint8_t>(resolved.begin(), resolved.end())});
   mcap_->write_metadata("paddock", {{"scenario", sc.source}, {"seed", std::to_string(sc.scenario.seed)},
-                                    {"transport", "wire"}});
+                                    {"transport", sc.hal.transport == Transport::Udp ? "udp" : "wire"}});
 
   packets_ = channel("/lidar/packets", "", "ouster.lidar_packet.legacy");
   can_rx_ = channel("/can/rx", "", "socketcan.can_frame");
@@ -303,34 +303,13 @@ void RunLog::can_frame(TimeNs at, bool to_stack, const std::uint8_t* frame) {
 }
 
 void RunLog::message(TimeNs at, const hal::SensorMessage& m) {
-  std::visit(
-      [this, at](const auto& msg) {
-        using T = std::decay_t<decltype(msg)>;
-        if constexpr (std::is_same_v<T, hal::CameraDetections>) {
-          json boxes = json::array();
-          for (const hal::CameraBox& b : msg.boxes)
-            boxes.push_back({{"x_min", b.x_min}, {"y_min", b.y_min}, {"x_max", b.x_max}, {"y_max", b.y_max},
-                             {"color", static_cast<int>(b.color)}, {"confidence", b.confidence}});
-          write(detections_, at,
-                json{{"stamp", msg.stamp}, {"width", msg.width}, {"height", msg.height}, {"boxes", boxes}}.dump());
-        } else if constexpr (std::is_same_v<T, hal::ConeDetections>) {
-          json cones = json::array();
-          for (const hal::DetectedCone& c : msg.cones)
-            cones.push_back({{"x", c.position.x}, {"y", c.position.y}, {"color", static_cast<int>(c.color)},
-                             {"colour_from_camera", c.colour_from_camera}});
-          json free = json::array();
-          // +infinity (nothing seen) is no JSON number: null
-          for (const float f : msg.free_range) free.push_back(std::isfinite(f) ? json(f) : json(nullptr));
-          write(cones_, at, json{{"stamp", msg.stamp}, {"cones", cones}, {"free_range", free}}.dump());
-        } else if constexpr (std::is_same_v<T, hal::StateEstimate>) {
-          write(state_, at,
-                json{{"stamp", msg.stamp}, {"x", msg.pose.x}, {"y", msg.pose.y}, {"yaw", msg.pose.yaw},
-                     {"vx", msg.vx}, {"vy", msg.vy}, {"yaw_rate", msg.yaw_rate}}
-                    .dump());
-        }
-        // what travels on a wire is logged as its bytes (lidar_packet, can_frame)
-      },
-      m);
+  // what travels on a wire is logged as its bytes (lidar_packet, can_frame)
+  const std::optional<std::string> j = hal::to_json(m);
+  if (!j) return;
+  const std::uint16_t ch = std::holds_alternative<hal::CameraDetections>(m) ? detections_
+                           : std::holds_alternative<hal::ConeDetections>(m) ? cones_
+                                                                            : state_;
+  write(ch, at, *j);
 }
 
 void RunLog::observe(const SimModel& model, SimState& s) {

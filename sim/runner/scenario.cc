@@ -222,12 +222,12 @@ void load_hal_files(Scenario& s, const std::vector<IniEntry>& entries, const std
       throw UserError(e.what());
     }
   }
-  if (s.hal.transport == Transport::Wire) {
+  if (s.hal.transport != Transport::Memory) {
     const bool lidar = s.autonomy.perception != stack::PerceptionMode::GroundTruth;
     if (lidar && s.hal.lidar_metadata.empty())
-      throw UserError(path + ": [hal] transport = wire sends the LiDAR's packets: [hal] lidar_metadata must name its metadata file");
+      throw UserError(path + ": [hal] transport = wire or udp sends the LiDAR's packets: [hal] lidar_metadata must name its metadata file");
     if (s.hal.dbc.empty())
-      throw UserError(path + ": [hal] transport = wire sends the car's CAN frames: [hal] dbc must name the car's DBC file");
+      throw UserError(path + ": [hal] transport = wire or udp sends the car's CAN frames: [hal] dbc must name the car's DBC file");
   }
 }
 

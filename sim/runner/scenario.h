@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "autonomy/car/car.h"
 #include "autonomy/hal/car_can.h"
 #include "autonomy/hal/dbc.h"
 #include "autonomy/hal/ouster.h"
@@ -62,6 +63,10 @@ enum class Transport {
   // car's own decoders, as on the car; the actuator command goes back as a
   // CAN frame
   Wire,
+  // the wire's bytes over UDP to a car binary (paddock car, with the same
+  // scenario) that runs the stack in its own process, in lock-step: the
+  // software-in-the-loop test of the car's binary ([car] says where it listens)
+  Udp,
 };
 
 struct HalSection {
@@ -71,11 +76,11 @@ struct HalSection {
   std::string lidar_metadata;
   std::string dbc;
 
-  static constexpr params::Choice<Transport> kTransports[] = {{"memory", Transport::Memory},
-                                                              {"wire", Transport::Wire}};
+  static constexpr params::Choice<Transport> kTransports[] = {
+      {"memory", Transport::Memory}, {"wire", Transport::Wire}, {"udp", Transport::Udp}};
   template <class V>
   void visit(V& v) {
-    v(PADDOCK_PARAM(transport), kTransports, "memory: the messages as structs; wire: through their wire formats and the car's decoders");
+    v(PADDOCK_PARAM(transport), kTransports, "memory: the messages as structs; wire: through their wire formats and the car's decoders; udp: the wire's bytes to a car binary (paddock car) in lock-step");
     v(PADDOCK_PARAM(lidar_metadata), "the LiDAR's metadata file (Ouster sensor_info JSON): the layout the simulated LiDAR casts and the decoder reads");
     v(PADDOCK_PARAM(dbc), "the car's CAN database (DBC): the frames of the IMU, wheel speeds, steering, RES and commands");
   }
@@ -154,6 +159,7 @@ struct Scenario {
   ScenarioSection scenario;
   stack::AutonomyModes autonomy;
   HalSection hal;
+  car::CarParams car;
   // the car and the world
   vehicle::VehicleParams vehicle;
   world::ConeWorldParams cones;
@@ -187,6 +193,7 @@ struct Scenario {
     v.section(PADDOCK_PARAM(scenario), "the event, its track and the run's seed");
     v.section(PADDOCK_PARAM(autonomy), "where each layer of the stack gets its input: the real module or ground truth");
     v.section(PADDOCK_PARAM(hal), "the HAL between the simulator and the stack: transport and the sensors' wire descriptions");
+    v.section(PADDOCK_PARAM(car), "the car binary (paddock car): its sockets, clock and watchdogs; transport = udp sends to it");
     v.section(PADDOCK_PARAM(vehicle), "every physical parameter of the car, all required: include = vehicles/default.ini");
     v.section(PADDOCK_PARAM(cones), "the cones' physics (Box2D): masses, knock-over impulses, frictions");
     v.section(PADDOCK_PARAM(ground), "the ground the sensors see (the vehicle model stays planar)");

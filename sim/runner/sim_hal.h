@@ -31,7 +31,15 @@ class SimHal final : public hal::Hal {
     if (wire_ && wire_->has_lidar() && std::holds_alternative<hal::LidarScan>(m))
       throw std::logic_error("transport = wire: the LiDAR's scans cross the HAL as its packets (post_lidar)");
     if (tap_) tap_->message(now_, m);
+    if (remote()) return wire_->send_object(now_, m);
     inbox_.push_back(std::move(m));
+  }
+  // transport = udp: the stack runs in a car binary, not in this process
+  bool remote() const { return wire_ && wire_->remote(); }
+  // transport = udp: the car binary's control cycle at the current instant;
+  // its command to the actuators
+  void remote_cycle() {
+    if (std::optional<hal::ActuatorCommand> d = wire_->remote_cycle(now_)) sent_ = command_ = *d;
   }
   // transport = wire: one LiDAR rotation's packets, decoded by the car's decoder
   void post_lidar(const std::vector<std::uint8_t>& packets) { wire_->carry_lidar(packets, inbox_, now_); }

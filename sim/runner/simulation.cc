@@ -83,7 +83,12 @@ void control(const SimModel& model, SimState& s, const Pose2& base) {
     s.go_sent = true;
     s.event.start(s.t);
   }
-  s.stack.tick(s.now, s.hal);
+  // transport = udp: the stack is the car binary's, in its own process
+  if (s.hal.remote()) {
+    s.hal.remote_cycle();
+  } else {
+    s.stack.tick(s.now, s.hal);
+  }
   if (s.hal.command()) {
     const hal::ActuatorCommand& c = *s.hal.command();
     s.input = vehicle::DriverInput{c.steering_angle, c.throttle, c.brake, c.yaw_moment};
@@ -164,11 +169,14 @@ RunResult results_of(const SimState& s) {
   return r;
 }
 
-// transport = wire: the car's wires (the LiDAR's only when the stack reads it)
+// transport = wire | udp: the car's wires (the LiDAR's only when the stack
+// reads it); udp: to a car binary
 std::unique_ptr<WireLink> make_wire(const Scenario& sc) {
-  if (sc.hal.transport != Transport::Wire) return nullptr;
+  if (sc.hal.transport == Transport::Memory) return nullptr;
   const bool lidar = sc.autonomy.perception != stack::PerceptionMode::GroundTruth;
-  return std::make_unique<WireLink>(lidar ? sc.lidar_info : std::nullopt, sc.lidar, *sc.dbc, sc.hal.dbc);
+  auto wire = std::make_unique<WireLink>(lidar ? sc.lidar_info : std::nullopt, sc.lidar, *sc.dbc, sc.hal.dbc);
+  if (sc.hal.transport == Transport::Udp) wire->set_remote(std::make_unique<CarLink>(sc.car));
+  return wire;
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -256,6 +264,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
   }
 
   RunResult result = results_of(state);
+  result.stack_remote = state.hal.remote();
   result.log = std::move(log.rows());
   result.sim_time = result.log.empty() ? 0.0 : result.log.back().t;
   tracking_from_log(result.event.laps, result.log, 1.0 / scenario.sim.log_rate, result.lap_tracking, result.tracking);

@@ -119,6 +119,10 @@ struct RunResult {
   int fallbacks = 0;       // control cycles in the safe stop
   std::string fault;       // the stack's last fault, if any
   int cycles = 0;          // control cycles run
+  // transport = udp: the stack ran in the car binary, so what is measured
+  // inside it (tracking, the estimate, the map, fallbacks, perception) is
+  // not known here
+  bool stack_remote = false;
   PerceptionMetrics perception;  // the stack's perceived cones against the truth, per range bin
   SlamMetrics slam;              // the stack's state estimate against the truth
   std::optional<PerceptionSnapshot> snapshot;

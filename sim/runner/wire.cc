@@ -5,6 +5,8 @@
 #include <type_traits>
 #include <variant>
 
+#include "autonomy/hal/json.h"
+
 namespace paddock::runner {
 
 WireLink::WireLink(const std::optional<hal::ouster::SensorInfo>& lidar, const hal::LidarLayout& layout,
@@ -22,30 +24,35 @@ bool WireLink::on_can(const hal::SensorMessage& m) {
 }
 
 // one frame onto the bus and off it: the 16 bytes of struct can_frame, read
-// back with the frame's time as the receive stamp
-void WireLink::carry_frame(const hal::CanFrame& f, hal::CarCan& to, bool to_stack, TimeNs now) {
+// back with the frame's time as the receive stamp (to: none when another
+// process reads the bus)
+void WireLink::carry_frame(const hal::CanFrame& f, hal::CarCan* to, bool to_stack, TimeNs now) {
   std::uint8_t bytes[hal::kSocketCanFrameSize];
   hal::to_socketcan(f, bytes);
   if (tap_) tap_->can_frame(now, to_stack, bytes);
   ++counters_.can_frames;
   counters_.can_bytes += hal::kSocketCanFrameSize;
-  if (const std::optional<hal::CanFrame> r = hal::from_socketcan(bytes, sizeof bytes, f.stamp)) to.push(*r);
+  if (!to) return;
+  if (const std::optional<hal::CanFrame> r = hal::from_socketcan(bytes, sizeof bytes, f.stamp)) to->push(*r);
 }
 
 void WireLink::carry(const hal::SensorMessage& m, std::deque<hal::SensorMessage>& out, TimeNs now) {
-  std::visit(
-      [this, now](const auto& msg) {
+  const std::vector<hal::CanFrame> frames = std::visit(
+      [this](const auto& msg) -> std::vector<hal::CanFrame> {
         using T = std::decay_t<decltype(msg)>;
         if constexpr (std::is_same_v<T, hal::Imu>) {
-          for (const hal::CanFrame& f : vcu_.encode(msg)) carry_frame(f, acu_, true, now);
+          return vcu_.encode(msg);
         } else if constexpr (std::is_same_v<T, hal::WheelSpeeds> || std::is_same_v<T, hal::SteeringAngle> ||
                              std::is_same_v<T, hal::ResSignal>) {
-          carry_frame(vcu_.encode(msg), acu_, true, now);
+          return {vcu_.encode(msg)};
         } else {
           throw std::logic_error("WireLink::carry: not a message of the CAN bus");
         }
       },
       m);
+  // to the car binary's bus, or to the stack's side of ours
+  for (const hal::CanFrame& f : frames) carry_frame(f, remote_ ? nullptr : &acu_, true, now);
+  if (remote_) return remote_->can_frames(now, frames);
   while (std::optional<hal::SensorMessage> d = acu_.pop_sensor()) out.push_back(std::move(*d));
 }
 
@@ -54,7 +61,11 @@ void WireLink::carry_lidar(const std::vector<std::uint8_t>& packets, std::deque<
   if (!decoder_) throw std::logic_error("WireLink::carry_lidar: no LiDAR metadata");
   for (std::size_t at = 0; at + packet_size_ <= packets.size(); at += packet_size_) {
     if (tap_) tap_->lidar_packet(now, packets.data() + at, packet_size_);
-    decoder_->push(packets.data() + at, packet_size_);
+    if (remote_) {
+      remote_->lidar_packet(now, packets.data() + at, packet_size_);
+    } else {
+      decoder_->push(packets.data() + at, packet_size_);
+    }
     ++counters_.lidar_packets;
     counters_.lidar_bytes += packet_size_;
   }
@@ -62,7 +73,7 @@ void WireLink::carry_lidar(const std::vector<std::uint8_t>& packets, std::deque<
 }
 
 std::optional<hal::ActuatorCommand> WireLink::carry(const hal::ActuatorCommand& c, TimeNs now) {
-  carry_frame(acu_.encode(c), vcu_, false, now);
+  carry_frame(acu_.encode(c), &vcu_, false, now);
   std::optional<hal::ActuatorCommand> last;
   while (std::optional<hal::ActuatorCommand> d = vcu_.pop_command()) last = *d;
   return last;
@@ -87,6 +98,19 @@ void WireLink::encode_lidar(const std::vector<sensors::LidarPoint>& points, cons
     px.signal = static_cast<std::uint16_t>(std::lround(static_cast<double>(p.intensity) * hal::ouster::kSignalFullScale));
   }
   hal::ouster::encode(*info_, image, out);
+}
+
+std::optional<hal::ActuatorCommand> WireLink::remote_cycle(TimeNs now) {
+  for (const hal::CanFrame& f : remote_->tick(now)) carry_frame(f, &vcu_, false, now);
+  std::optional<hal::ActuatorCommand> last;
+  while (std::optional<hal::ActuatorCommand> d = vcu_.pop_command()) last = *d;
+  return last;
+}
+
+void WireLink::send_object(TimeNs now, const hal::SensorMessage& m) {
+  const std::optional<std::string> json = hal::to_json(m);
+  if (!json) throw std::logic_error("WireLink::send_object: a message that travels on a wire");
+  remote_->object(now, *json);
 }
 
 WireCounters WireLink::counters() const {

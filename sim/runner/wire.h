@@ -17,6 +17,7 @@
 #include "autonomy/hal/dbc.h"
 #include "autonomy/hal/messages.h"
 #include "autonomy/hal/ouster.h"
+#include "sim/runner/car_link.h"
 #include "sim/sensors/lidar.h"
 
 namespace paddock::runner {
@@ -66,6 +67,18 @@ class WireLink {
   // who sees the bytes (none: nobody)
   void set_tap(WireTap* tap) { tap_ = tap; }
 
+  // transport = udp: the stack's end of the wires is a car binary's, over
+  // `link`; what carry() and carry_lidar() take goes to it (their `out` stays
+  // empty), and its control cycles run through remote_cycle()
+  void set_remote(std::unique_ptr<CarLink> link) { remote_ = std::move(link); }
+  bool remote() const { return remote_ != nullptr; }
+  // the car binary's control cycle at `now`: its command as the VCU decodes
+  // it (nothing if it dropped the frame)
+  std::optional<hal::ActuatorCommand> remote_cycle(TimeNs now);
+  // a message no wire of the car carries (the detector node's boxes) to the
+  // car binary, as its JSON
+  void send_object(TimeNs now, const hal::SensorMessage& m);
+
   // the rotation's packets from the simulated LiDAR's points (each with its
   // column and ring): frame `frame_id`, column c fired at column_time(c)
   // (the sensor's timestamps); every column valid, the pixels without a
@@ -77,7 +90,7 @@ class WireLink {
   WireCounters counters() const;
 
  private:
-  void carry_frame(const hal::CanFrame& f, hal::CarCan& to, bool to_stack, TimeNs now);
+  void carry_frame(const hal::CanFrame& f, hal::CarCan* to, bool to_stack, TimeNs now);
 
   std::optional<hal::ouster::SensorInfo> info_;
   std::unique_ptr<hal::ouster::Decoder> decoder_;
@@ -87,6 +100,7 @@ class WireLink {
   hal::CarCan acu_;  // the stack's computer: takes the sensors' frames, sends the command
   WireCounters counters_;
   WireTap* tap_ = nullptr;
+  std::unique_ptr<CarLink> remote_;
 };
 
 }  // namespace paddock::runner

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <optional>
 #include <variant>
@@ -22,6 +23,7 @@
 #include "sim/runner/sim_hal.h"
 #include "sim/runner/simulation.h"
 #include "sim/world/cone_world.h"
+#include "tests/runner/background.h"
 #include "tests/runner/run_paddock.h"
 
 namespace paddock::runner {
@@ -187,23 +189,71 @@ TEST(Transport, TheWireCarriesTheCanSensorsAndTheCommandWithinHalfAStep) {
 // the same autocross on both transports: raw LiDAR and camera, FastSLAM and
 // the graph. The runs part where the wire quantises (the CAN sensors, the
 // command), so the lap differs by what that changes, not by a cone
-TEST(Transport, BothTransportsDriveTheSameAutocross) {
+// the car binary's first line: the ports it listens on
+struct CarPorts {
+  int lidar = 0, can = 0, objects = 0;
+};
+std::optional<CarPorts> ports_of(const std::optional<std::string>& line) {
+  CarPorts p;
+  if (!line || std::sscanf(line->c_str(), "paddock car: listening on %*[^:]: lidar udp %d, can udp %d, objects udp %d",
+                           &p.lidar, &p.can, &p.objects) != 3)
+    return std::nullopt;
+  return p;
+}
+
+std::vector<std::string> car_ports(const CarPorts& p) {
+  return {"car.lidar_port=" + std::to_string(p.lidar), "car.can_port=" + std::to_string(p.can),
+          "car.objects_port=" + std::to_string(p.objects)};
+}
+
+// the closed loop on the three transports: memory and wire drive the same
+// autocross to within the CAN quantisation's butterfly effect; udp, the
+// stack in the car binary as a second process in lock-step (software in the
+// loop), drives the wire's run to the bit: the same lap, energy, cones
+TEST(Transport, TheThreeTransportsDriveTheSameAutocross) {
   const OnTrack& a = autocross();
-  Scenario wire = a.scenario;
-  wire.hal.transport = Transport::Wire;
-  const RunResult m = run(a.scenario, a.track);
-  const RunResult w = run(wire, a.track);
+  const std::string ac = kRoot + "/scenarios/fsg_2023_autocross_wire.ini";
+  testing::Background car("car " + ac + " --set car.lidar_port=0 --set car.can_port=0 --set car.objects_port=0");
+  const std::optional<CarPorts> ports = ports_of(car.line(120.0));
+  ASSERT_TRUE(ports) << car.output();
+  std::vector<std::string> sets = car_ports(*ports);
+  sets.push_back("hal.transport=udp");
+  const Scenario udp = load_scenario(ac, sets);
+  std::future<RunResult> memory = std::async(std::launch::async, [&a] { return run(a.scenario, a.track); });
+  std::future<RunResult> wired = std::async(std::launch::async, [&a] {
+    Scenario wire = a.scenario;
+    wire.hal.transport = Transport::Wire;
+    return run(wire, a.track);
+  });
+  const RunResult u = run(udp, a.track);
+  const int car_exit = car.wait(120.0);
+  const RunResult m = memory.get(), w = wired.get();
   ASSERT_EQ(m.event.laps.size(), 1u);
   ASSERT_EQ(w.event.laps.size(), 1u);
-  const double tm = m.event.laps[0].time, tw = w.event.laps[0].time;
-  std::printf("autocross: memory %.3f s, wire %.3f s (%+.2f %%); ATE rms %.3f / %.3f m; DOO %d / %d\n", tm, tw,
-              100.0 * (tw - tm) / tm, m.slam.ate_rms, w.slam.ate_rms, m.event.doo, w.event.doo);
+  ASSERT_EQ(u.event.laps.size(), 1u) << car.output();
+  const double tm = m.event.laps[0].time, tw = w.event.laps[0].time, tu = u.event.laps[0].time;
+  std::printf("autocross: memory %.3f s, wire %.3f s (%+.2f %%), udp %.3f s; ATE rms %.3f / %.3f m; DOO %d / %d\n", tm,
+              tw, 100.0 * (tw - tm) / tm, tu, m.slam.ate_rms, w.slam.ate_rms, m.event.doo, w.event.doo);
   EXPECT_TRUE(m.event.finished);
   EXPECT_TRUE(w.event.finished);
   EXPECT_EQ(w.event.doo, 0);
   EXPECT_EQ(w.event.oc, 0);
   EXPECT_NEAR(tw, tm, 0.02 * tm);
   EXPECT_LT(w.slam.ate_rms, 0.15);
+  // the car binary's run is the in-process wire run
+  EXPECT_TRUE(u.stack_remote);
+  EXPECT_TRUE(u.event.finished) << u.event.dnf_reason;
+  EXPECT_EQ(tu, tw);
+  EXPECT_EQ(u.energy, w.energy);
+  EXPECT_EQ(u.event.doo, w.event.doo);
+  EXPECT_EQ(u.sim_time, w.sim_time);
+  EXPECT_EQ(car_exit, 0) << car.output();
+  const std::string out = car.output();
+  EXPECT_NE(out.find("paddock car: done after " + std::to_string(u.cycles) + " control cycles, AS finished"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("fault    -"), std::string::npos) << out;
+  EXPECT_NE(out.find("0 unknown id, 0 bad dlc, 0 unmatched IMU halves"), std::string::npos) << out;
 }
 
 // a wire run needs both files; a [lidar] key the metadata sets must agree with it
