@@ -27,7 +27,7 @@ class SocketCan {
  public:
   explicit SocketCan(const std::string& interface) : name_(interface) {
     fd_ = ::socket(PF_CAN, SOCK_RAW | SOCK_CLOEXEC, CAN_RAW);
-    if (fd_ < 0) throw std::runtime_error("SocketCAN: " + std::string(std::strerror(errno)));
+    if (fd_ < 0) fail("this kernel has no SocketCAN (" + std::string(std::strerror(errno)) + "; modprobe can_raw)");
     ifreq ifr{};
     if (interface.size() >= sizeof ifr.ifr_name) fail("the name is too long");
     std::memcpy(ifr.ifr_name, interface.c_str(), interface.size() + 1);
@@ -59,7 +59,7 @@ class SocketCan {
 
  private:
   [[noreturn]] void fail(const std::string& why) {
-    ::close(fd_);
+    if (fd_ >= 0) ::close(fd_);
     fd_ = -1;
     throw std::runtime_error("no CAN interface '" + name_ + "': " + why +
                              " (ip link shows the interfaces; without one, leave [car] can_interface empty for CAN over UDP)");

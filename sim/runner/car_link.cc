@@ -35,7 +35,7 @@ hal::CanDatagram CarLink::await(hal::CanDatagram::Kind kind, TimeNs now) {
   std::snprintf(at, sizeof at, " at t = %.3f s", to_seconds(now));
   const std::string who = "the car binary (" + car_.host + ":" + std::to_string(car_.can_port) + ")";
   if (!socket_.receive(buf_, from_seconds(car_.peer_timeout)))
-    throw std::runtime_error(who + " did not answer the " + hal::to_string(kind) + at + " within " +
+    throw std::runtime_error(who + " gave no " + hal::to_string(kind) + at + " within " +
                              std::to_string(car_.peer_timeout) + " s ([car] peer_timeout): is `paddock car` running?");
   std::string why;
   const std::optional<hal::CanDatagram> d = hal::decode_datagram(buf_.data(), buf_.size(), &why);

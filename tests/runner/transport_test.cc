@@ -8,6 +8,9 @@
 // butterfly effect.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -17,6 +20,8 @@
 #include <variant>
 #include <vector>
 
+#include "autonomy/hal/can_udp.h"
+#include "autonomy/hal/udp.h"
 #include "sim/runner/files.h"
 #include "sim/runner/model.h"
 #include "sim/runner/raw_sensors.h"
@@ -254,6 +259,80 @@ TEST(Transport, TheThreeTransportsDriveTheSameAutocross) {
       << out;
   EXPECT_NE(out.find("fault    -"), std::string::npos) << out;
   EXPECT_NE(out.find("0 unknown id, 0 bad dlc, 0 unmatched IMU halves"), std::string::npos) << out;
+}
+
+// the car binary on its own clock (as on the car): a control cycle's command
+// for every CAN datagram's sender; when the CAN bus goes silent for 0.1 s the
+// watchdog puts it in AS Emergency with the brakes on, and SIGTERM stops it
+// with its summary
+TEST(Transport, TheCarBinarysWatchdogStopsACarWhoseBusWentSilent) {
+  const std::string ac = kRoot + "/scenarios/fsg_2023_autocross_wire.ini";
+  testing::Background car("car " + ac +
+                          " --set car.clock=wall --set car.lidar_port=0 --set car.can_port=0 --set car.objects_port=0");
+  const std::optional<CarPorts> ports = ports_of(car.line(120.0));
+  ASSERT_TRUE(ports) << car.output();
+  const Scenario sc = autocross().scenario;
+  hal::CarCan vcu(*sc.dbc, sc.hal.dbc);
+  hal::UdpSocket vcu_socket("127.0.0.1", 0);
+  const sockaddr_in to = hal::UdpSocket::address("127.0.0.1", ports->can);
+  // the commands that came back: their AS states, in order
+  std::vector<hal::AsState> states;
+  std::vector<std::uint8_t> buf;
+  const auto take_commands = [&] {
+    while (vcu_socket.receive(buf, 0)) {
+      const std::optional<hal::CanDatagram> d = hal::decode_datagram(buf.data(), buf.size());
+      ASSERT_TRUE(d);
+      for (const hal::CanFrame& f : d->frames) vcu.push(f);
+      while (const std::optional<hal::ActuatorCommand> c = vcu.pop_command()) states.push_back(c->as_state);
+    }
+  };
+  // 0.5 s of wheel speeds at 100 Hz
+  for (std::uint32_t k = 0; k < 50; ++k) {
+    hal::CanDatagram d;
+    d.sequence = k;
+    d.frames.push_back(vcu.encode(hal::WheelSpeeds{0, {5.0, 5.0, 5.0, 5.0}}));
+    const std::vector<std::uint8_t> bytes = hal::encode(d);
+    vcu_socket.send_to(to, bytes.data(), bytes.size());
+    take_commands();
+    ::usleep(10'000);
+  }
+  const std::size_t while_alive = states.size();
+  // then silence, until the emergency comes (a generous bound: the machine may be busy)
+  for (int i = 0; i < 500 && (states.empty() || states.back() != hal::AsState::Emergency); ++i) {
+    ::usleep(10'000);
+    take_commands();
+  }
+  car.signal(SIGTERM);
+  EXPECT_EQ(car.wait(30.0), 0) << car.output();
+  ASSERT_GT(while_alive, 10u) << "the car answered " << while_alive << " cycles while the bus was alive";
+  for (std::size_t i = 0; i < while_alive; ++i) EXPECT_EQ(states[i], hal::AsState::Off) << i;
+  ASSERT_FALSE(states.empty());
+  EXPECT_EQ(states.back(), hal::AsState::Emergency);
+  EXPECT_NE(car.output().find("fault    watchdog: no sensor frame on the CAN bus"), std::string::npos) << car.output();
+  EXPECT_NE(car.output().find("AS emergency"), std::string::npos) << car.output();
+}
+
+// what cannot work says so: no CAN interface of that name; a simulator whose
+// car binary is not there; a port already taken
+TEST(Transport, TheCarBinaryAndItsLinkSayWhatIsMissing) {
+  const std::string ac = kRoot + "/scenarios/fsg_2023_autocross_wire.ini";
+  const testing::Outcome no_bus =
+      testing::run_paddock("car " + ac + " --set car.clock=wall --set car.can_interface=paddock_nocan0 --set car.lidar_port=0 --set car.objects_port=0");
+  EXPECT_EQ(no_bus.code, 2);
+  EXPECT_NE(no_bus.output.find("no CAN interface 'paddock_nocan0'"), std::string::npos) << no_bus.output;
+  const testing::Outcome lockstep_bus = testing::run_paddock("car " + ac + " --set car.can_interface=can0");
+  EXPECT_EQ(lockstep_bus.code, 2);
+  EXPECT_NE(lockstep_bus.output.find("can_interface must be empty"), std::string::npos) << lockstep_bus.output;
+  // a port nobody listens on (taken here, so nothing else has it)
+  hal::UdpSocket taken("127.0.0.1", 0);
+  const std::string port = std::to_string(taken.port());
+  const testing::Outcome alone = testing::run_paddock("run " + ac + " --set hal.transport=udp --set car.can_port=" + port +
+                                                      " --set car.peer_timeout=0.5 --out /tmp/paddock_sil_alone");
+  EXPECT_EQ(alone.code, 2);
+  EXPECT_NE(alone.output.find("gave no reply at t = 0.000 s within 0.5"), std::string::npos) << alone.output;
+  const testing::Outcome busy = testing::run_paddock("car " + ac + " --set car.can_port=" + port);
+  EXPECT_EQ(busy.code, 2);
+  EXPECT_NE(busy.output.find("cannot listen on UDP 127.0.0.1:" + port), std::string::npos) << busy.output;
 }
 
 // a wire run needs both files; a [lidar] key the metadata sets must agree with it
