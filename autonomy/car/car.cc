@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cstring>
 #include <ctime>
+#include <memory>
 #include <ostream>
 #include <stdexcept>
 #include <vector>
@@ -74,6 +75,42 @@ TimeNs wall_now() {
   return static_cast<TimeNs>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
 }
 
+// the node and what the car logs of it: every message as it is taken in,
+// each cycle's command and outputs
+struct Car {
+  CarNode& node;
+  CarLog* log = nullptr;
+
+  void lidar_packet(TimeNs at, const std::vector<std::uint8_t>& p) {
+    node.lidar_packet(at, p.data(), p.size());
+    if (log) log->lidar_packet(at, p.data(), p.size());
+  }
+  void can_frame(TimeNs at, const hal::CanFrame& f) {
+    node.can_frame(f);
+    if (!log) return;
+    std::uint8_t bytes[hal::kSocketCanFrameSize];
+    hal::to_socketcan(f, bytes);
+    log->can_frame(at, true, bytes);
+  }
+  void object(TimeNs at, const std::vector<std::uint8_t>& p) {
+    const hal::SensorMessage* m = node.object(at, reinterpret_cast<const char*>(p.data()), p.size());
+    if (log && m) log->message(at, *m);
+  }
+  // the control cycle: the command's frame, stamped `at`
+  hal::CanFrame cycle(TimeNs at) {
+    const hal::ActuatorCommand c = node.tick(at);
+    hal::CanFrame f = node.command_frame(c);
+    f.stamp = at;
+    if (log) {
+      std::uint8_t bytes[hal::kSocketCanFrameSize];
+      hal::to_socketcan(f, bytes);
+      log->can_frame(at, false, bytes);
+      log->cycle(at, c, node.stack());
+    }
+    return f;
+  }
+};
+
 void print_summary(std::ostream& out, const CarNode& node, long lockstep_datagrams) {
   const CarCounters c = node.counters();
   out << "paddock car: done after " << c.ticks << " control cycles, AS "
@@ -94,7 +131,7 @@ void print_summary(std::ostream& out, const CarNode& node, long lockstep_datagra
 
 // lock-step: the CAN channel's datagrams drive; the LiDAR's and the objects'
 // are taken when a datagram counts them
-void run_lockstep(const CarSetup& s, CarNode& node, hal::UdpSocket& lidar, hal::UdpSocket& can,
+void run_lockstep(const CarSetup& s, Car& car, hal::UdpSocket& lidar, hal::UdpSocket& can,
                   hal::UdpSocket& objects, std::ostream& out, const volatile std::sig_atomic_t* stop) {
   const TimeNs timeout = from_seconds(s.car.peer_timeout);
   std::vector<std::uint8_t> buf;
@@ -124,23 +161,22 @@ void run_lockstep(const CarSetup& s, CarNode& node, hal::UdpSocket& lidar, hal::
     while (lidar_taken < d->lidar_before) {
       if (!lidar.receive(buf, timeout))
         throw std::runtime_error("lock-step: LiDAR packet " + std::to_string(lidar_taken) + " never came");
-      node.lidar_packet(d->time, buf.data(), buf.size());
+      car.lidar_packet(d->time, buf);
       ++lidar_taken;
     }
     while (objects_taken < d->objects_before) {
       if (!objects.receive(buf, timeout))
         throw std::runtime_error("lock-step: object message " + std::to_string(objects_taken) + " never came");
-      node.object(d->time, reinterpret_cast<const char*>(buf.data()), buf.size());
+      car.object(d->time, buf);
       ++objects_taken;
     }
-    for (const hal::CanFrame& f : d->frames) node.can_frame(f);
+    for (const hal::CanFrame& f : d->frames) car.can_frame(d->time, f);
     hal::CanDatagram answer;
     answer.time = d->time;
     answer.sequence = reply_sequence;
     if (d->kind == hal::CanDatagram::Kind::Tick) {
       answer.kind = hal::CanDatagram::Kind::Reply;
-      answer.frames.push_back(node.command_frame(node.tick(d->time)));
-      answer.frames.back().stamp = d->time;
+      answer.frames.push_back(car.cycle(d->time));
     } else if (d->kind == hal::CanDatagram::Kind::Sync) {
       answer.kind = hal::CanDatagram::Kind::Ack;
     } else if (d->kind == hal::CanDatagram::Kind::End) {
@@ -154,11 +190,11 @@ void run_lockstep(const CarSetup& s, CarNode& node, hal::UdpSocket& lidar, hal::
     can.send_to(from, bytes.data(), bytes.size());
     ++reply_sequence;
   }
-  print_summary(out, node, datagrams);
+  print_summary(out, car.node, datagrams);
 }
 
 // the car: its own clock, a control cycle every period
-void run_wall(const CarSetup& s, CarNode& node, hal::UdpSocket& lidar, hal::UdpSocket* can_udp, SocketCan* can_bus,
+void run_wall(const CarSetup& s, Car& car, hal::UdpSocket& lidar, hal::UdpSocket* can_udp, SocketCan* can_bus,
               hal::UdpSocket& objects, std::ostream& out, const volatile std::sig_atomic_t* stop) {
   std::vector<std::uint8_t> buf;
   std::optional<sockaddr_in> peer;  // CAN over UDP: where the commands go
@@ -175,9 +211,9 @@ void run_wall(const CarSetup& s, CarNode& node, hal::UdpSocket& lidar, hal::UdpS
         throw std::runtime_error(std::string("poll: ") + std::strerror(errno));
       now = wall_now();
     }
-    while (lidar.receive(buf, 0)) node.lidar_packet(now, buf.data(), buf.size());
+    while (lidar.receive(buf, 0)) car.lidar_packet(now, buf);
     if (can_bus) {
-      while (const std::optional<hal::CanFrame> f = can_bus->receive(now)) node.can_frame(*f);
+      while (const std::optional<hal::CanFrame> f = can_bus->receive(now)) car.can_frame(now, *f);
     } else {
       sockaddr_in from{};
       while (can_udp->receive(buf, 0, &from)) {
@@ -185,15 +221,14 @@ void run_wall(const CarSetup& s, CarNode& node, hal::UdpSocket& lidar, hal::UdpS
         if (const std::optional<hal::CanDatagram> d = hal::decode_datagram(buf.data(), buf.size())) {
           for (hal::CanFrame f : d->frames) {
             f.stamp = now;  // on the car a frame is stamped when it is received
-            node.can_frame(f);
+            car.can_frame(now, f);
           }
         }
       }
     }
-    while (objects.receive(buf, 0)) node.object(now, reinterpret_cast<const char*>(buf.data()), buf.size());
+    while (objects.receive(buf, 0)) car.object(now, buf);
     if (now < next_tick) continue;
-    hal::CanFrame command = node.command_frame(node.tick(now));
-    command.stamp = now;
+    const hal::CanFrame command = car.cycle(now);
     if (can_bus) {
       can_bus->send(command);
     } else if (peer) {
@@ -207,7 +242,7 @@ void run_wall(const CarSetup& s, CarNode& node, hal::UdpSocket& lidar, hal::UdpS
     // a late cycle is not made up: the next one is a period after this one's due time, or now
     next_tick = std::max(next_tick + s.control_period, now);
   }
-  print_summary(out, node, 0);
+  print_summary(out, car.node, 0);
 }
 
 }  // namespace
@@ -230,10 +265,24 @@ void run_car(const CarSetup& s, std::ostream& out, const volatile std::sig_atomi
       << (can_udp ? "udp " + std::to_string(can_udp->port()) : "socketcan " + s.car.can_interface)
       << ", objects udp " << objects.port() << "; clock " << (s.car.clock == Clock::Lockstep ? "lockstep" : "wall")
       << std::endl;
-  if (s.car.clock == Clock::Lockstep) {
-    run_lockstep(s, node, lidar, *can_udp, objects, out, stop);
-  } else {
-    run_wall(s, node, lidar, can_udp ? &*can_udp : nullptr, can_bus ? &*can_bus : nullptr, objects, out, stop);
+  std::unique_ptr<CarLog> log;
+  if (!s.log_path.empty())
+    log = std::make_unique<CarLog>(s.log_path, s.log_files, s.log_metadata, s.lidar, s.layout, s.log_pose_period);
+  Car car{node, log.get()};
+  try {
+    if (s.car.clock == Clock::Lockstep) {
+      run_lockstep(s, car, lidar, *can_udp, objects, out, stop);
+    } else {
+      run_wall(s, car, lidar, can_udp ? &*can_udp : nullptr, can_bus ? &*can_bus : nullptr, objects, out, stop);
+    }
+  } catch (const std::exception&) {
+    // what the car logged up to the fault is the log that matters most
+    if (log) log->close();
+    throw;
+  }
+  if (log) {
+    log->close();
+    out << "  log      " << s.log_path << std::endl;
   }
 }
 

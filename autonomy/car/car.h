@@ -22,7 +22,9 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "autonomy/car/car_log.h"
 #include "autonomy/car/car_node.h"
 #include "autonomy/common/params.h"
 
@@ -72,6 +74,12 @@ struct CarSetup {
   std::string dbc_source;
   CarParams car;
   TimeNs control_period = 10'000'000;  // clock = wall
+  // the car's log (car_log.h): none when empty; the files a reader needs,
+  // the file's metadata, the estimate's poses at most this often
+  std::string log_path;
+  std::vector<CarLog::File> log_files;
+  log::KeyValues log_metadata;
+  TimeNs log_pose_period = 10'000'000;
 };
 
 // the ports the sockets got (a port asked as 0 gets a free one)
@@ -82,7 +90,8 @@ struct CarPorts {
 // runs the car until the simulator's end datagram (lock-step) or *stop turns
 // non-zero (a signal handler sets it); prints a line once the sockets are
 // open ("paddock car: listening ...", with the ports) and a summary at the
-// end to `out`. Throws std::runtime_error when a socket cannot be opened (a
+// end to `out`; the log (if asked) is closed and in place at the end, and
+// when an error stops the car. Throws std::runtime_error when a socket cannot be opened (a
 // busy port, no such CAN interface) or the lock-step peer breaks the protocol
 // or goes silent for peer_timeout
 void run_car(const CarSetup& setup, std::ostream& out, const volatile std::sig_atomic_t* stop);

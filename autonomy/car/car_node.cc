@@ -38,13 +38,15 @@ void CarNode::can_frame(const hal::CanFrame& frame) {
   while (std::optional<hal::SensorMessage> m = can_.pop_sensor()) inbox_.messages.push_back(std::move(*m));
 }
 
-void CarNode::object(TimeNs, const char* data, std::size_t size) {
+const hal::SensorMessage* CarNode::object(TimeNs, const char* data, std::size_t size) {
   try {
     inbox_.messages.push_back(hal::message_from_json(data, size));
     ++counters_.objects;
+    return &inbox_.messages.back();
   } catch (const std::invalid_argument& e) {
     ++counters_.bad_objects;
     last_bad_object_ = e.what();
+    return nullptr;
   }
 }
 

@@ -58,9 +58,10 @@ class CarNode {
   void lidar_packet(TimeNs received, const std::uint8_t* data, std::size_t size);
   // one frame off the CAN bus, stamped with its receive time
   void can_frame(const hal::CanFrame& frame);
-  // one object message (hal/json.h); a bad one is dropped, counted, and its
-  // reason kept (last_bad_object)
-  void object(TimeNs received, const char* data, std::size_t size);
+  // one object message (hal/json.h): the message taken (valid until the
+  // next call), or none when it was bad (dropped, counted, its reason kept:
+  // last_bad_object)
+  const hal::SensorMessage* object(TimeNs received, const char* data, std::size_t size);
 
   // the control cycle at `now`: the watchdogs, then the stack; the command
   // it sent (AS Emergency with the brakes on once a watchdog fired)

@@ -46,12 +46,14 @@ const char* kUsage =
     "      reruns the stack on a run's log (paddock run ... --log) without the simulator:\n"
     "      the recorded packets and frames through the car's decoders. Unchanged it gives\n"
     "      the live run's commands bit for bit; with --set it says where they differ.\n"
-    "  paddock car SCENARIO.ini [--set section.key=value]...\n"
+    "  paddock car SCENARIO.ini [--set section.key=value]... [--log] [--out DIR]\n"
     "      the car binary: the scenario's stack alone behind the car's sockets ([car]:\n"
     "      the LiDAR's UDP packets, the CAN bus by SocketCAN or CAN over UDP, the\n"
     "      detector node's boxes), with its watchdogs. clock = lockstep runs with\n"
     "      paddock run ... --set hal.transport=udp (software in the loop); clock = wall\n"
-    "      runs on the car. Stops at the simulator's end, or on SIGINT/SIGTERM\n"
+    "      runs on the car. Stops at the simulator's end, or on SIGINT/SIGTERM. --log\n"
+    "      writes DIR/run.mcap (DIR defaults to runs/car_<scenario name>), which\n"
+    "      paddock replay reruns\n"
     "  paddock sweep SWEEP.ini [--jobs N] [--out DIR] [--resume] [--shard i/n] [--plots]\n"
     "      runs a sweep's points (scenarios x [vary] values x seeds) on N cores (default:\n"
     "      all) into DIR (default runs/<sweep name>): DIR/points/NNNN/{scenario.ini,\n"
@@ -473,13 +475,19 @@ int cmd_replay(const std::vector<std::string>& args) {
 volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_stop_signal(int) { g_stop = 1; }
 
-// car SCENARIO.ini [--set k=v]...
+// car SCENARIO.ini [--set k=v]... [--log] [--out DIR]
 int cmd_car(const std::vector<std::string>& args) {
-  std::string path;
+  std::string path, out_dir;
   std::vector<std::string> overrides;
+  bool log = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
-    if (a == "--set") {
+    if (a == "--log") {
+      log = true;
+    } else if (a == "--out") {
+      if (i + 1 >= args.size()) throw UserError("--out needs a value");
+      out_dir = args[++i];
+    } else if (a == "--set") {
       if (i + 1 >= args.size()) throw UserError("--set needs a value");
       overrides.push_back(args[++i]);
     } else if (a.rfind("--set=", 0) == 0) {
@@ -511,6 +519,16 @@ int cmd_car(const std::vector<std::string>& args) {
   setup.dbc_source = scenario.hal.dbc;
   setup.car = scenario.car;
   setup.control_period = model.dt_ns * model.every.control;
+  if (log) {
+    if (out_dir.empty()) out_dir = "runs/car_" + scenario.name;
+    std::filesystem::create_directories(out_dir);
+    setup.log_path = out_dir + "/run.mcap";
+    setup.log_files = log_attachments(scenario);
+    setup.log_metadata = {{"scenario", scenario.source},
+                          {"binary", "paddock car"},
+                          {"clock", scenario.car.clock == car::Clock::Lockstep ? "lockstep" : "wall"}};
+    setup.log_pose_period = kNsPerSecond / scenario.sim.log_rate;
+  }
   struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   sigemptyset(&sa.sa_mask);

@@ -92,34 +92,42 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
   }
 
   ReplayResult r;
+  // the control cycles: where the log has the stack's commands, at their
+  // instants (the live run's cycles, on any clock), each compared with its
+  // command; else (the stack ran elsewhere) every control period
+  bool by_commands = false;
+  const std::optional<log::Statistics>& stats = reader.statistics();
+  for (const auto& [id, k] : kind) {
+    if (k != kCommand) continue;
+    if (!stats) {  // no Statistics record: its command channel is taken to have some
+      by_commands = true;
+      continue;
+    }
+    const auto n = stats->channel_message_counts.find(id);
+    by_commands = by_commands || (n != stats->channel_message_counts.end() && n->second > 0);
+  }
   const TimeNs period = model.dt_ns * model.every.control;
   const TimeNs from = o.from ? from_seconds(*o.from) : 0;
   const TimeNs until = o.until ? from_seconds(*o.until) : std::numeric_limits<TimeNs>::max();
-  TimeNs tick = (from + period - 1) / period * period;  // the first control cycle at or after --from
-  std::map<TimeNs, LoggedCommand> logged;
-  // the control cycle at `tick`: the stack, its command against the live one
-  const auto cycle = [&]() {
-    const hal::ActuatorCommand c = node.tick(tick);
+  TimeNs tick = (from + period - 1) / period * period;  // the first period cycle at or after --from
+  // the control cycle at t: the stack, its command against the live one (if logged)
+  const auto cycle = [&](TimeNs t, const LoggedCommand* l) {
+    const hal::ActuatorCommand c = node.tick(t);
     ++r.cycles;
-    const auto it = logged.find(tick);
-    if (it != logged.end()) {
-      const LoggedCommand& l = it->second;
-      ++r.compared;
-      const bool same = c.steering_angle == l.steering && c.throttle == l.throttle && c.brake == l.brake &&
-                        c.yaw_moment == l.yaw_moment && hal::to_string(c.as_state) == l.as_state;
-      if (same) {
-        ++r.identical;
-      } else if (!r.first_difference) {
-        r.first_difference = to_seconds(tick);
-      }
-      r.max_steering_difference = std::max(r.max_steering_difference, std::abs(c.steering_angle - l.steering));
-      r.max_throttle_difference = std::max(r.max_throttle_difference, std::abs(c.throttle - l.throttle));
-      r.max_brake_difference = std::max(r.max_brake_difference, std::abs(c.brake - l.brake));
-      if (hal::to_string(c.as_state) != l.as_state) ++r.as_state_differences;
-      logged.erase(logged.begin(), std::next(it));
-    }
     r.final_as_state = hal::to_string(c.as_state);
-    tick += period;
+    if (!l) return;
+    ++r.compared;
+    const bool same = c.steering_angle == l->steering && c.throttle == l->throttle && c.brake == l->brake &&
+                      c.yaw_moment == l->yaw_moment && hal::to_string(c.as_state) == l->as_state;
+    if (same) {
+      ++r.identical;
+    } else if (!r.first_difference) {
+      r.first_difference = to_seconds(t);
+    }
+    r.max_steering_difference = std::max(r.max_steering_difference, std::abs(c.steering_angle - l->steering));
+    r.max_throttle_difference = std::max(r.max_throttle_difference, std::abs(c.throttle - l->throttle));
+    r.max_brake_difference = std::max(r.max_brake_difference, std::abs(c.brake - l->brake));
+    if (hal::to_string(c.as_state) != l->as_state) ++r.as_state_differences;
   };
 
   try {
@@ -130,8 +138,10 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
     while (messages.next(m)) {
       const auto at = static_cast<TimeNs>(m.log_time);
       if (at > until) break;
-      // the cycles before this message
-      while (tick < at && tick <= until) cycle();
+      // the period's cycles before this message
+      if (!by_commands) {
+        for (; tick < at; tick += period) cycle(tick, nullptr);
+      }
       const Kind k = kind.count(m.channel_id) ? kind[m.channel_id] : kOther;
       switch (k) {
         case kPackets:
@@ -155,10 +165,12 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
           break;
         }
         case kCommand: {
+          // logged after what the cycle took in: the cycle runs now
           const json j = json::parse(m.data, m.data + m.size);
-          logged[at] = {j.at("steering_angle").get<double>(), j.at("throttle").get<double>(),
-                        j.at("brake").get<double>(), j.at("yaw_moment").get<double>(),
-                        j.at("as_state").get<std::string>()};
+          const LoggedCommand l{j.at("steering_angle").get<double>(), j.at("throttle").get<double>(),
+                                j.at("brake").get<double>(), j.at("yaw_moment").get<double>(),
+                                j.at("as_state").get<std::string>()};
+          cycle(at, &l);
           break;
         }
         case kOther:
@@ -166,8 +178,10 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
       }
       r.log_time = to_seconds(at);
     }
-    // the cycles up to the last message's instant
-    while (tick <= from_seconds(r.log_time) && tick <= until) cycle();
+    // the period's cycles up to the last message's instant
+    if (!by_commands) {
+      for (; tick <= from_seconds(r.log_time) && tick <= until; tick += period) cycle(tick, nullptr);
+    }
   } catch (const log::McapError& e) {
     throw UserError(path + ": " + e.what());
   } catch (const json::exception& e) {
@@ -189,7 +203,9 @@ std::string replay_text(const std::string& path, const ReplayResult& r) {
   std::snprintf(buf, sizeof buf, "  stack       %ld control cycles, final AS state %s\n", r.cycles,
                 r.final_as_state.empty() ? "-" : r.final_as_state.c_str());
   o << buf;
-  if (r.compared == r.identical) {
+  if (r.compared == 0) {
+    o << "  commands    none in the log to compare with (the stack ran in the car binary: replay its log)\n";
+  } else if (r.compared == r.identical) {
     std::snprintf(buf, sizeof buf, "  commands    %ld compared with the log: all identical, bit for bit\n", r.compared);
     o << buf;
   } else {

@@ -14,11 +14,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <future>
 #include <limits>
 #include <optional>
 #include <variant>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "autonomy/hal/can_udp.h"
 #include "autonomy/hal/udp.h"
@@ -264,11 +267,16 @@ TEST(Transport, TheThreeTransportsDriveTheSameAutocross) {
 // the car binary on its own clock (as on the car): a control cycle's command
 // for every CAN datagram's sender; when the CAN bus goes silent for 0.1 s the
 // watchdog puts it in AS Emergency with the brakes on, and SIGTERM stops it
-// with its summary
+// with its summary. Its log: read whole by the official MCAP reader, and
+// replayed (at the cycles' own instants, off any grid) to the bit
 TEST(Transport, TheCarBinarysWatchdogStopsACarWhoseBusWentSilent) {
   const std::string ac = kRoot + "/scenarios/fsg_2023_autocross_wire.ini";
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("paddock_car_wall_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
   testing::Background car("car " + ac +
-                          " --set car.clock=wall --set car.lidar_port=0 --set car.can_port=0 --set car.objects_port=0");
+                          " --set car.clock=wall --set car.lidar_port=0 --set car.can_port=0 --set car.objects_port=0"
+                          " --log --out " + dir.string());
   const std::optional<CarPorts> ports = ports_of(car.line(120.0));
   ASSERT_TRUE(ports) << car.output();
   const Scenario sc = autocross().scenario;
@@ -310,6 +318,28 @@ TEST(Transport, TheCarBinarysWatchdogStopsACarWhoseBusWentSilent) {
   EXPECT_EQ(states.back(), hal::AsState::Emergency);
   EXPECT_NE(car.output().find("fault    watchdog: no sensor frame on the CAN bus"), std::string::npos) << car.output();
   EXPECT_NE(car.output().find("AS emergency"), std::string::npos) << car.output();
+
+  const std::string log = (dir / "run.mcap").string();
+  ASSERT_TRUE(std::filesystem::exists(log)) << car.output();
+  const std::string modules = (std::filesystem::current_path() / "mcap-validator" / "node_modules").string();
+  ASSERT_TRUE(std::filesystem::exists(std::filesystem::path(modules) / "@mcap" / "core"))
+      << "the official MCAP reader is needed: run ./paddock test, which installs it into <build>/mcap-validator";
+  const testing::Outcome read = testing::run_paddock_command("NODE_PATH='" + modules + "' node '" + kRoot +
+                                                             "/tests/log/validate_mcap.mjs' '" + log + "' 2>&1");
+  ASSERT_EQ(read.code, 0) << read.output;
+  const nlohmann::json topics = nlohmann::json::parse(read.output).at("topics");
+  EXPECT_EQ(topics.at("/can/rx").get<long>(), 50);
+  const long cycles = topics.at("/stack/command").get<long>();
+  EXPECT_EQ(topics.at("/can/tx").get<long>(), cycles);
+  EXPECT_GE(static_cast<std::size_t>(cycles), states.size());
+  const testing::Outcome replayed = testing::run_paddock("replay " + log);
+  EXPECT_EQ(replayed.code, 0) << replayed.output;
+  EXPECT_NE(replayed.output.find(std::to_string(cycles) + " compared with the log: all identical, bit for bit"),
+            std::string::npos)
+      << replayed.output;
+  EXPECT_NE(replayed.output.find("watchdog    watchdog: no sensor frame on the CAN bus"), std::string::npos)
+      << replayed.output;
+  std::filesystem::remove_all(dir);
 }
 
 // what cannot work says so: no CAN interface of that name; a simulator whose

@@ -1,0 +1,56 @@
+#pragma once
+// Foxglove's well-known JSON schemas (https://docs.foxglove.dev/docs/
+// visualization/message-schemas) as JSON Schema, and their values: what a
+// run's log (and the car's) writes so Foxglove draws the car, the scan, the
+// cones and the path in 3D.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "autonomy/common/cone.h"
+#include "autonomy/common/time.h"
+
+namespace paddock::log::foxglove {
+
+using nlohmann::json;
+
+// the schemas, each with its "title" (the schema's name in the MCAP file)
+std::string frame_transform_schema();
+std::string pose_in_frame_schema();
+std::string scene_update_schema();
+std::string point_cloud_schema();
+// paddock's own JSON messages: an object of these properties named `title`
+std::string object_schema(const char* title, json properties);
+json number_schema();
+json integer_schema();
+json string_schema();
+json boolean_schema();
+json array_schema(json items);
+json object_of(json properties);
+
+// the values
+json stamp(TimeNs t);  // {sec, nsec}, nsec in [0, 1e9)
+json position(double x, double y, double z);
+// yaw about z, then pitch about the new y: q = q_z(yaw) q_y(pitch)
+json rotation(double yaw, double pitch = 0.0);
+json pose(double x, double y, double z, double yaw);
+json rgba(double r, double g, double b, double a = 1.0);
+// foxglove.FrameTransform
+json transform(TimeNs at, const char* parent, const char* child, double x, double y, double z, double yaw,
+               double pitch = 0.0);
+// foxglove.PoseInFrame
+json pose_in_frame(TimeNs at, const char* frame, double x, double y, double yaw);
+// foxglove.SceneUpdate: the cones as one entity `id` of cylinders (tapered:
+// a cone) in the map frame, coloured as they are
+json cones_update(const std::vector<Cone>& cones, TimeNs at, const char* id);
+// foxglove.SceneUpdate: a line strip `id` through the points (z = 2 cm), closed if asked
+json line_update(const std::vector<Vec2>& points, bool closed, TimeNs at, const char* id);
+// foxglove.PointCloud of float32 x, y, z, intensity per point, in `frame`
+json point_cloud(TimeNs at, const char* frame, const std::vector<float>& xyzi);
+// RFC 4648 base64 (a JSON `bytes` field)
+std::string base64(const std::uint8_t* p, std::size_t n);
+
+}  // namespace paddock::log::foxglove
