@@ -12,6 +12,9 @@
 //                    its annotation (a pass over the labels, the error model)
 //   BM_Fusion        fuse() of 60 candidates (the cones within 20 m ahead and
 //                    a few fakes) with that frame's boxes
+//   BM_JpegEncode    hal::encode_jpeg of that frame at the log's quality (85):
+//                    a run's log keeps every camera frame so
+//   BM_JpegDecode    hal::decode_jpeg of it (the car's MJPEG camera)
 // Counters: mean and p99 (ms) of the timed calls, rays cast, instances.
 #include <benchmark/benchmark.h>
 
@@ -20,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/hal/image.h"
 #include "autonomy/perception/fusion.h"
 #include "bench/bench_scenes.h"
 #include "sim/sensors/annotation_detector.h"
@@ -151,5 +155,31 @@ void BM_Fusion(benchmark::State& state) {
   state.counters["kept"] = kept;
 }
 BENCHMARK(BM_Fusion)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+namespace {
+
+void BM_JpegEncode(benchmark::State& state) {
+  const Scene s = start_scene();
+  std::size_t bytes = 0;
+  for (auto _ : state) {
+    const std::vector<std::uint8_t> jpeg = hal::encode_jpeg(s.shot.frame, 85);
+    bytes = jpeg.size();
+    benchmark::DoNotOptimize(jpeg.data());
+  }
+  state.counters["bytes"] = static_cast<double>(bytes);
+}
+BENCHMARK(BM_JpegEncode)->Unit(benchmark::kMillisecond);
+
+void BM_JpegDecode(benchmark::State& state) {
+  const Scene s = start_scene();
+  const std::vector<std::uint8_t> jpeg = hal::encode_jpeg(s.shot.frame, 85);
+  for (auto _ : state) {
+    const hal::CameraFrame f = hal::decode_jpeg(jpeg.data(), jpeg.size(), 0);
+    benchmark::DoNotOptimize(f.rgb.data());
+  }
+}
+BENCHMARK(BM_JpegDecode)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -17,7 +17,9 @@
 #include <stdexcept>
 #include <vector>
 
+#include "autonomy/car/camera.h"
 #include "autonomy/hal/can_udp.h"
+#include "autonomy/hal/image.h"
 #include "autonomy/hal/udp.h"
 
 namespace paddock::car {
@@ -75,6 +77,9 @@ TimeNs wall_now() {
   return static_cast<TimeNs>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
 }
 
+// the log's JPEG quality for the frames a camera sends uncompressed
+constexpr int kJpegQuality = 85;
+
 // the node and what the car logs of it: every message as it is taken in,
 // each cycle's command and outputs
 struct Car {
@@ -91,6 +96,11 @@ struct Car {
     std::uint8_t bytes[hal::kSocketCanFrameSize];
     hal::to_socketcan(f, bytes);
     log->can_frame(at, true, bytes);
+  }
+  // a camera frame; jpeg: its bytes when the camera sent JPEG (else the log encodes it)
+  void camera(TimeNs at, hal::CameraFrame frame, const std::vector<std::uint8_t>& jpeg) {
+    if (log) log->image(at, frame.stamp, jpeg.empty() ? hal::encode_jpeg(frame, kJpegQuality) : jpeg);
+    node.camera_frame(std::move(frame));
   }
   void object(TimeNs at, const std::vector<std::uint8_t>& p) {
     const hal::SensorMessage* m = node.object(at, reinterpret_cast<const char*>(p.data()), p.size());
@@ -120,6 +130,7 @@ void print_summary(std::ostream& out, const CarNode& node, long lockstep_datagra
       << c.lidar.late_columns << " late columns; " << c.lidar.lost_columns << " columns lost\n";
   out << "  can      " << c.can_frames << " frames; dropped: " << c.can.unknown_id << " unknown id, " << c.can.bad_dlc
       << " bad dlc, " << c.can.unmatched_imu_halves << " unmatched IMU halves\n";
+  if (c.camera_frames > 0) out << "  camera   " << c.camera_frames << " frames\n";
   out << "  objects  " << c.objects << " messages, " << c.bad_objects << " dropped";
   if (!node.last_bad_object().empty()) out << " (last: " << node.last_bad_object() << ")";
   out << "\n";
@@ -195,7 +206,8 @@ void run_lockstep(const CarSetup& s, Car& car, hal::UdpSocket& lidar, hal::UdpSo
 
 // the car: its own clock, a control cycle every period
 void run_wall(const CarSetup& s, Car& car, hal::UdpSocket& lidar, hal::UdpSocket* can_udp, SocketCan* can_bus,
-              hal::UdpSocket& objects, std::ostream& out, const volatile std::sig_atomic_t* stop) {
+              hal::UdpSocket& objects, V4l2Camera* camera, std::ostream& out, const volatile std::sig_atomic_t* stop) {
+  std::vector<std::uint8_t> jpeg;
   std::vector<std::uint8_t> buf;
   std::optional<sockaddr_in> peer;  // CAN over UDP: where the commands go
   std::uint32_t sequence = 0;
@@ -204,10 +216,11 @@ void run_wall(const CarSetup& s, Car& car, hal::UdpSocket& lidar, hal::UdpSocket
   while (!(stop && *stop)) {
     TimeNs now = wall_now();
     if (now < next_tick) {
-      pollfd p[3] = {{lidar.fd(), POLLIN, 0}, {can_fd, POLLIN, 0}, {objects.fd(), POLLIN, 0}};
+      pollfd p[4] = {{lidar.fd(), POLLIN, 0}, {can_fd, POLLIN, 0}, {objects.fd(), POLLIN, 0},
+                     {camera ? camera->fd() : -1, POLLIN, 0}};
       const TimeNs wait = next_tick - now;
       timespec ts{static_cast<time_t>(wait / kNsPerSecond), static_cast<long>(wait % kNsPerSecond)};
-      if (::ppoll(p, 3, &ts, nullptr) < 0 && errno != EINTR)
+      if (::ppoll(p, camera ? 4 : 3, &ts, nullptr) < 0 && errno != EINTR)
         throw std::runtime_error(std::string("poll: ") + std::strerror(errno));
       now = wall_now();
     }
@@ -227,6 +240,9 @@ void run_wall(const CarSetup& s, Car& car, hal::UdpSocket& lidar, hal::UdpSocket
       }
     }
     while (objects.receive(buf, 0)) car.object(now, buf);
+    if (camera) {
+      while (std::optional<hal::CameraFrame> f = camera->read(now, &jpeg)) car.camera(now, std::move(*f), jpeg);
+    }
     if (now < next_tick) continue;
     const hal::CanFrame command = car.cycle(now);
     if (can_bus) {
@@ -265,6 +281,12 @@ void run_car(const CarSetup& s, std::ostream& out, const volatile std::sig_atomi
       << (can_udp ? "udp " + std::to_string(can_udp->port()) : "socketcan " + s.car.can_interface)
       << ", objects udp " << objects.port() << "; clock " << (s.car.clock == Clock::Lockstep ? "lockstep" : "wall")
       << std::endl;
+  std::optional<V4l2Camera> camera;
+  if (!s.car.camera_device.empty()) {
+    camera.emplace(s.car.camera_device, s.camera_width, s.camera_height);
+    out << "paddock car: camera " << s.car.camera_device << ", " << s.camera_width << "x" << s.camera_height << " "
+        << camera->format() << std::endl;
+  }
   std::unique_ptr<CarLog> log;
   if (!s.log_path.empty())
     log = std::make_unique<CarLog>(s.log_path, s.log_files, s.log_metadata, s.lidar, s.layout, s.log_pose_period);
@@ -273,7 +295,8 @@ void run_car(const CarSetup& s, std::ostream& out, const volatile std::sig_atomi
     if (s.car.clock == Clock::Lockstep) {
       run_lockstep(s, car, lidar, *can_udp, objects, out, stop);
     } else {
-      run_wall(s, car, lidar, can_udp ? &*can_udp : nullptr, can_bus ? &*can_bus : nullptr, objects, out, stop);
+      run_wall(s, car, lidar, can_udp ? &*can_udp : nullptr, can_bus ? &*can_bus : nullptr, objects,
+               camera ? &*camera : nullptr, out, stop);
     }
   } catch (const std::exception&) {
     // what the car logged up to the fault is the log that matters most

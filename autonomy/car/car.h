@@ -3,8 +3,8 @@
 // the car's sockets. The LiDAR's UDP packets come to lidar_port, the CAN bus
 // through a SocketCAN interface (can_interface) or as CAN over UDP
 // (hal/can_udp.h) on can_port, the object messages (hal/json.h: a detector
-// node's boxes) as UDP datagrams on objects_port; the actuator command goes
-// back on the bus. Two clocks:
+// node's boxes) as UDP datagrams on objects_port, the camera's frames from
+// its V4L2 device (camera.h); the actuator command goes back on the bus. Two clocks:
 //   lockstep  the simulator drives the time (paddock run with [hal]
 //             transport = udp): the CAN channel's datagrams carry the
 //             simulated time, and the car runs a control cycle when a tick
@@ -41,6 +41,7 @@ struct CarParams {
   int can_port = 7600;
   int objects_port = 7601;
   std::string can_interface;  // a SocketCAN interface (can0); empty: CAN over UDP
+  std::string camera_device;  // a V4L2 camera (/dev/video0); empty: none
   Clock clock = Clock::Lockstep;
   // lock-step: how long either side waits for the other (wall time)
   double peer_timeout = 30.0;
@@ -54,6 +55,7 @@ struct CarParams {
     v(PADDOCK_PARAM(can_port), {"", params::in(0, 65535), "UDP port of CAN over UDP (0: any free port)"});
     v(PADDOCK_PARAM(objects_port), {"", params::in(0, 65535), "UDP port of the object messages: the detector node's boxes (0: any free port)"});
     v(PADDOCK_PARAM(can_interface), "the SocketCAN interface of the car's bus (e.g. can0); empty: CAN over UDP on can_port");
+    v(PADDOCK_PARAM(camera_device), "the camera's V4L2 device (e.g. /dev/video0), streamed at [camera] width x height; empty: no camera (clock = wall only)");
     v(PADDOCK_PARAM(clock), kClocks, "lockstep: the simulator's time, carried in the CAN datagrams; wall: the computer's clock");
     v(PADDOCK_PARAM(peer_timeout), {"s", params::in(0.1, 3600.0), "lock-step: wall time either side waits for the other before it gives up"});
     v.section(PADDOCK_PARAM(watchdog), "the sensors' watchdogs: AS Emergency when one goes silent");
@@ -61,6 +63,8 @@ struct CarParams {
   std::string check() const {
     if (clock == Clock::Lockstep && !can_interface.empty())
       return "clock = lockstep carries the time in CAN over UDP: can_interface must be empty";
+    if (clock == Clock::Lockstep && !camera_device.empty())
+      return "clock = lockstep takes the simulator's detector boxes, not a camera: camera_device must be empty";
     return "";
   }
 };
@@ -74,6 +78,7 @@ struct CarSetup {
   std::string dbc_source;
   CarParams car;
   TimeNs control_period = 10'000'000;  // clock = wall
+  int camera_width = 0, camera_height = 0;  // car.camera_device's image size
   // the car's log (car_log.h): none when empty; the files a reader needs,
   // the file's metadata, the estimate's poses at most this often
   std::string log_path;

@@ -68,6 +68,7 @@ CarLog::CarLog(const std::string& path, const std::vector<File>& attachments, co
   map_ = channel("/stack/map", fg::scene_update_schema(), "json");
   path_ = channel("/stack/path", fg::scene_update_schema(), "json");
   points_ = channel("/lidar/points", fg::point_cloud_schema(), "json");
+  image_ = channel("/camera/image", fg::compressed_image_schema(), "json");
 }
 
 CarLog::~CarLog() = default;
@@ -119,6 +120,10 @@ void CarLog::message(TimeNs at, const hal::SensorMessage& m) {
                            : std::holds_alternative<hal::ConeDetections>(m) ? cones_
                                                                             : state_;
   write(ch, at, *j);
+}
+
+void CarLog::image(TimeNs at, TimeNs stamp, const std::vector<std::uint8_t>& jpeg) {
+  write(image_, at, fg::compressed_image(stamp, "camera", jpeg, "jpeg").dump());
 }
 
 void CarLog::cycle(TimeNs at, const hal::ActuatorCommand& c, const stack::Stack& stack) {

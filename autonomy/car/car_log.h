@@ -21,6 +21,7 @@
 //   /stack/map       foxglove.SceneUpdate        the stack's cone map (1 Hz)
 //   /stack/path      foxglove.SceneUpdate        the trajectory it follows (when it changes, at most 2 Hz)
 //   /lidar/points    foxglove.PointCloud         every kPointCloudEvery-th rotation, decoded from its packets
+//   /camera/image    foxglove.CompressedImage    the camera's frames, JPEG
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -58,6 +59,8 @@ class CarLog {
   void can_frame(TimeNs at, bool to_stack, const std::uint8_t* frame);
   // a message no wire carries (the others are logged as their bytes: nothing)
   void message(TimeNs at, const hal::SensorMessage& m);
+  // a camera frame, as JPEG bytes, exposed at `stamp`
+  void image(TimeNs at, TimeNs stamp, const std::vector<std::uint8_t>& jpeg);
   // the control cycle at `at`: the command the stack sent, and what it made
   // of the world (its estimate, map and path)
   void cycle(TimeNs at, const hal::ActuatorCommand& command, const stack::Stack& stack);
@@ -79,7 +82,7 @@ class CarLog {
   std::vector<std::uint32_t> sequence_;           // per channel
   std::map<std::string, std::uint16_t> schemas_;  // by name
   std::uint16_t packets_ = 0, can_rx_ = 0, can_tx_ = 0, detections_ = 0, cones_ = 0, state_ = 0, tf_ = 0,
-                pose_ = 0, command_ = 0, map_ = 0, path_ = 0, points_ = 0;
+                pose_ = 0, command_ = 0, map_ = 0, path_ = 0, points_ = 0, image_ = 0;
   bool mounted_ = false;  // base -> lidar written
   long rotations_ = 0;
   std::optional<TimeNs> next_pose_, next_map_, next_path_;

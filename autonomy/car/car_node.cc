@@ -38,6 +38,11 @@ void CarNode::can_frame(const hal::CanFrame& frame) {
   while (std::optional<hal::SensorMessage> m = can_.pop_sensor()) inbox_.messages.push_back(std::move(*m));
 }
 
+void CarNode::camera_frame(hal::CameraFrame frame) {
+  ++counters_.camera_frames;
+  inbox_.messages.push_back(std::move(frame));
+}
+
 const hal::SensorMessage* CarNode::object(TimeNs, const char* data, std::size_t size) {
   try {
     inbox_.messages.push_back(hal::message_from_json(data, size));

@@ -39,6 +39,7 @@ struct WatchdogParams {
 struct CarCounters {
   std::uint64_t lidar_packets = 0;
   std::uint64_t can_frames = 0;
+  std::uint64_t camera_frames = 0;
   std::uint64_t objects = 0;      // object messages taken
   std::uint64_t bad_objects = 0;  // object messages dropped (no paddock JSON)
   std::uint64_t ticks = 0;
@@ -62,6 +63,9 @@ class CarNode {
   // next call), or none when it was bad (dropped, counted, its reason kept:
   // last_bad_object)
   const hal::SensorMessage* object(TimeNs received, const char* data, std::size_t size);
+
+  // one frame of the car's camera
+  void camera_frame(hal::CameraFrame frame);
 
   // the control cycle at `now`: the watchdogs, then the stack; the command
   // it sent (AS Emergency with the brakes on once a watchdog fired)

@@ -100,6 +100,18 @@ std::string point_cloud_schema() {
                 "foxglove.PointCloud");
 }
 
+std::string compressed_image_schema() {
+  return titled(object_of({{"timestamp", time_schema()},
+                           {"frame_id", string_schema()},
+                           {"data", {{"type", "string"}, {"contentEncoding", "base64"}}},
+                           {"format", string_schema()}}),
+                "foxglove.CompressedImage");
+}
+
+json compressed_image(TimeNs at, const char* frame, const std::vector<std::uint8_t>& data, const char* format) {
+  return {{"timestamp", stamp(at)}, {"frame_id", frame}, {"data", base64(data.data(), data.size())}, {"format", format}};
+}
+
 std::string object_schema(const char* title, json properties) { return titled(object_of(std::move(properties)), title); }
 
 json stamp(TimeNs t) {

@@ -22,6 +22,7 @@ std::string frame_transform_schema();
 std::string pose_in_frame_schema();
 std::string scene_update_schema();
 std::string point_cloud_schema();
+std::string compressed_image_schema();
 // paddock's own JSON messages: an object of these properties named `title`
 std::string object_schema(const char* title, json properties);
 json number_schema();
@@ -50,6 +51,8 @@ json cones_update(const std::vector<Cone>& cones, TimeNs at, const char* id);
 json line_update(const std::vector<Vec2>& points, bool closed, TimeNs at, const char* id);
 // foxglove.PointCloud of float32 x, y, z, intensity per point, in `frame`
 json point_cloud(TimeNs at, const char* frame, const std::vector<float>& xyzi);
+// foxglove.CompressedImage: an image's bytes in `format` ("jpeg") in `frame`
+json compressed_image(TimeNs at, const char* frame, const std::vector<std::uint8_t>& data, const char* format);
 // RFC 4648 base64 (a JSON `bytes` field)
 std::string base64(const std::uint8_t* p, std::size_t n);
 

@@ -519,6 +519,8 @@ int cmd_car(const std::vector<std::string>& args) {
   setup.dbc_source = scenario.hal.dbc;
   setup.car = scenario.car;
   setup.control_period = model.dt_ns * model.every.control;
+  setup.camera_width = scenario.camera.width;
+  setup.camera_height = scenario.camera.height;
   if (log) {
     if (out_dir.empty()) out_dir = "runs/car_" + scenario.name;
     std::filesystem::create_directories(out_dir);

@@ -1,5 +1,6 @@
 #include "sim/runner/run_log.h"
 
+#include "autonomy/hal/image.h"
 #include "autonomy/log/foxglove.h"
 #include "sim/runner/files.h"
 #include "sim/runner/scenario.h"
@@ -52,6 +53,11 @@ void RunLog::observe(const SimModel& model, SimState& s) {
   // it) and what it made of the world; with transport = udp the car binary
   // logs them
   if (s.controlled && !s.hal.remote() && s.hal.sent()) log_->cycle(at, *s.hal.sent(), s.stack);
+  // the camera's frames, as the car logs them
+  if (const hal::CameraFrame* f = s.raw ? s.raw->camera_frame() : nullptr; f && f->stamp != last_image_) {
+    last_image_ = f->stamp;
+    log_->image(at, f->stamp, hal::encode_jpeg(*f, kJpegQuality));
+  }
   // what was true: the pose at the log rate, the cones once a second
   if (s.k % log_every_ == 0) {
     const Pose2 truth = vehicle::base_pose(model.scenario.vehicle, s.car);

@@ -28,6 +28,9 @@ std::vector<car::CarLog::File> log_attachments(const Scenario& scenario);
 
 class RunLog final : public Observer, public WireTap {
  public:
+  // the camera's frames as JPEG of this quality
+  static constexpr int kJpegQuality = 85;
+
   // writes `path` (through path.tmp, renamed at close()); throws UserError
   // when the scenario does not run on the wire or the file cannot be made
   RunLog(const std::string& path, const Scenario& scenario);
@@ -45,6 +48,7 @@ class RunLog final : public Observer, public WireTap {
   std::unique_ptr<car::CarLog> log_;
   std::uint16_t truth_pose_ = 0, truth_cones_ = 0;
   TimeNs next_truth_cones_ = 0;
+  TimeNs last_image_ = -1;  // the camera frame last logged
   int log_every_ = 10;  // physics steps between true poses
 };
 

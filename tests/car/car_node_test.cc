@@ -1,7 +1,8 @@
 // the car binary's node without its sockets: the watchdogs turn a silent
 // sensor into AS Emergency (brakes on) after their timeouts and not before,
 // only the car's own frames count as a sign of life, a watchdog waits for its
-// sensor's first message, and a bad object message is dropped and counted
+// sensor's first message, and a bad object message is dropped and counted;
+// a camera device that is not there is named
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/car/camera.h"
 #include "autonomy/car/car_node.h"
 #include "autonomy/hal/car_can.h"
 #include "autonomy/hal/dbc.h"
@@ -122,6 +124,25 @@ TEST(CarNode, ABadObjectMessageIsDroppedAndCounted) {
   EXPECT_EQ(car.node.counters().objects, 1u);
   EXPECT_NE(car.node.last_bad_object().find("no JSON"), std::string::npos) << car.node.last_bad_object();
   EXPECT_NE(car.node.tick(0).as_state, hal::AsState::Emergency);
+}
+
+// a camera that is not there, or a device that is no camera, says so
+TEST(V4l2Camera, AMissingCameraIsNamed) {
+  try {
+    V4l2Camera c("/dev/paddock_no_camera", 800, 500);
+    ADD_FAILURE() << "opened";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("no camera at /dev/paddock_no_camera: No such file or directory"),
+              std::string::npos)
+        << e.what();
+  }
+  try {
+    V4l2Camera c("/dev/null", 800, 500);
+    ADD_FAILURE() << "opened";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/null is no V4L2 camera (VIDIOC_QUERYCAP:"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace
