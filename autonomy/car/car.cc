@@ -210,6 +210,7 @@ void run_wall(const CarSetup& s, Car& car, hal::UdpSocket& lidar, hal::UdpSocket
   std::vector<std::uint8_t> jpeg;
   std::vector<std::uint8_t> buf;
   std::optional<sockaddr_in> peer;  // CAN over UDP: where the commands go
+  long bad_datagrams = 0;
   std::uint32_t sequence = 0;
   TimeNs next_tick = wall_now();
   const int can_fd = can_bus ? can_bus->fd() : can_udp->fd();
@@ -230,12 +231,15 @@ void run_wall(const CarSetup& s, Car& car, hal::UdpSocket& lidar, hal::UdpSocket
     } else {
       sockaddr_in from{};
       while (can_udp->receive(buf, 0, &from)) {
+        const std::optional<hal::CanDatagram> d = hal::decode_datagram(buf.data(), buf.size());
+        if (!d) {
+          ++bad_datagrams;  // no CAN over UDP: dropped
+          continue;
+        }
         peer = from;
-        if (const std::optional<hal::CanDatagram> d = hal::decode_datagram(buf.data(), buf.size())) {
-          for (hal::CanFrame f : d->frames) {
-            f.stamp = now;  // on the car a frame is stamped when it is received
-            car.can_frame(now, f);
-          }
+        for (hal::CanFrame f : d->frames) {
+          f.stamp = now;  // on the car a frame is stamped when it is received
+          car.can_frame(now, f);
         }
       }
     }
@@ -259,6 +263,7 @@ void run_wall(const CarSetup& s, Car& car, hal::UdpSocket& lidar, hal::UdpSocket
     next_tick = std::max(next_tick + s.control_period, now);
   }
   print_summary(out, car.node, 0);
+  if (can_udp) out << "  can/udp  " << bad_datagrams << " datagrams that were no CAN over UDP, dropped" << std::endl;
 }
 
 }  // namespace

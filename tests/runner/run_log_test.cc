@@ -65,9 +65,11 @@ TEST(RunLog, TheOfficialReaderReadsTheRunsLogWithEveryTopic) {
   // the IMU's two frames at 200 Hz, wheels and steering at 100 Hz, the RES's go
   EXPECT_EQ(topics.at("/can/rx").get<long>(), 2 * (2 * cycles - 1) + cycles + cycles + 1);
   EXPECT_EQ(topics.at("/hal/detections").get<long>(), rotations);
+  EXPECT_EQ(topics.at("/camera/image").get<long>(), rotations);  // the LiDAR triggers the camera once a rotation
   for (const char* topic : {"/tf", "/stack/pose", "/truth/pose", "/stack/map", "/stack/path", "/truth/cones"})
     EXPECT_GT(topics.at(topic).get<long>(), 0) << topic;
-  for (const char* s : {"foxglove.FrameTransform", "foxglove.PoseInFrame", "foxglove.SceneUpdate", "foxglove.PointCloud"}) {
+  for (const char* s : {"foxglove.FrameTransform", "foxglove.PoseInFrame", "foxglove.SceneUpdate", "foxglove.PointCloud",
+                        "foxglove.CompressedImage"}) {
     bool found = false;
     for (const auto& name : j.at("schemas")) found = found || name.get<std::string>() == s;
     EXPECT_TRUE(found) << s;

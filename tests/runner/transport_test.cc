@@ -304,6 +304,10 @@ TEST(Transport, TheCarBinarysWatchdogStopsACarWhoseBusWentSilent) {
     take_commands();
     ::usleep(10'000);
   }
+  // garbage on the CAN port and the LiDAR's: dropped and counted, the car drives on
+  const std::uint8_t garbage[40] = {'P', 'D', 'K', 'C', 9};
+  vcu_socket.send_to(to, garbage, sizeof garbage);
+  vcu_socket.send_to(hal::UdpSocket::address("127.0.0.1", ports->lidar), garbage, sizeof garbage);
   const std::size_t while_alive = states.size();
   // then silence, until the emergency comes (a generous bound: the machine may be busy)
   for (int i = 0; i < 500 && (states.empty() || states.back() != hal::AsState::Emergency); ++i) {
@@ -318,6 +322,8 @@ TEST(Transport, TheCarBinarysWatchdogStopsACarWhoseBusWentSilent) {
   EXPECT_EQ(states.back(), hal::AsState::Emergency);
   EXPECT_NE(car.output().find("fault    watchdog: no sensor frame on the CAN bus"), std::string::npos) << car.output();
   EXPECT_NE(car.output().find("AS emergency"), std::string::npos) << car.output();
+  EXPECT_NE(car.output().find("can/udp  1 datagrams that were no CAN over UDP"), std::string::npos) << car.output();
+  EXPECT_NE(car.output().find("1 packets of a wrong size"), std::string::npos) << car.output();
 
   const std::string log = (dir / "run.mcap").string();
   ASSERT_TRUE(std::filesystem::exists(log)) << car.output();
