@@ -219,7 +219,7 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
     const auto& lap = ev.laps[i];
     const auto& tr = r.lap_tracking[i];
     laps.push_back({{"lap", lap.number}, {"start", lap.start}, {"time", lap.time}, {"timed", lap.timed},
-                    {"doo", lap.doo}, {"oc", lap.oc}, {"tracking", tracking(tr.rms, tr.max, tr.itae)},
+                    {"doo", lap.doo}, {"oc", lap.oc}, {"tracking", r.stack_remote ? Json(nullptr) : tracking(tr.rms, tr.max, tr.itae)},
                     {"energy", lap.energy},
                     {"above_limit", r.limit_lap ? Json(lap.time / *r.limit_lap - 1.0) : Json(nullptr)}});
   }
@@ -269,7 +269,7 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"tracking", r.stack_remote ? Json(nullptr) : tracking(r.tracking.rms, r.tracking.max, r.tracking.itae)},
       {"energy", r.energy},
       {"slam", r.stack_remote ? Json(nullptr) : Json(slam_json(s, r.slam))},
-      {"perception", perception},
+      {"perception", r.stack_remote ? Json(nullptr) : perception},
       {"stack", r.stack_remote ? Json("car binary") : Json{{"fallbacks", r.fallbacks}, {"fault", r.fault}}},
       {"expectations_failed", failed},
   };
