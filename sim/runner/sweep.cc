@@ -510,7 +510,10 @@ Scenario sweep_point_scenario(const SweepSpec& spec, const SweepPoint& point) {
     e.value = std::to_string(*point.seed);
     entries.push_back(e);
   }
-  return load_scenario_entries(entries, base);
+  Scenario sc = load_scenario_entries(entries, base);
+  if (sc.hal.transport == Transport::Udp)
+    throw UserError(base + ": [hal] transport = udp runs one simulation against one car binary; a sweep runs many side by side (use memory or wire)");
+  return sc;
 }
 
 namespace {

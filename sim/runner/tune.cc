@@ -150,7 +150,11 @@ class Tuner {
       e.value = std::to_string(*runs_[r].seed);
       entries.push_back(e);
     }
-    return load_scenario_entries(entries, spec_.scenarios[runs_[r].scenario]);
+    Scenario sc = load_scenario_entries(entries, spec_.scenarios[runs_[r].scenario]);
+    if (sc.hal.transport == Transport::Udp)
+      throw UserError(spec_.scenarios[runs_[r].scenario] +
+                      ": [hal] transport = udp runs one simulation against one car binary; a tune runs many side by side (use memory or wire)");
+    return sc;
   }
 
   // the keys' values in the scenarios as the tune file leaves them (the first

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <future>
 #include <limits>
 #include <optional>
@@ -369,6 +370,12 @@ TEST(Transport, TheCarBinaryAndItsLinkSayWhatIsMissing) {
   const testing::Outcome busy = testing::run_paddock("car " + ac + " --set car.can_port=" + port);
   EXPECT_EQ(busy.code, 2);
   EXPECT_NE(busy.output.find("cannot listen on UDP 127.0.0.1:" + port), std::string::npos) << busy.output;
+  // one car binary takes one simulation: a sweep on udp is refused before it runs
+  const std::string sweep = (std::filesystem::temp_directory_path() / ("paddock_udp_sweep_" + port + ".ini")).string();
+  std::ofstream(sweep) << "[sweep]\nscenarios = " << ac << "\n[vary]\ncontrol.stanley.k = 1, 2\n[hal]\ntransport = udp\n";
+  const testing::Outcome swept = testing::run_paddock("sweep " + sweep + " --out /tmp/paddock_udp_sweep_" + port);
+  EXPECT_EQ(swept.code, 2);
+  EXPECT_NE(swept.output.find("a sweep runs many side by side"), std::string::npos) << swept.output;
 }
 
 // a wire run needs both files; a [lidar] key the metadata sets must agree with it
