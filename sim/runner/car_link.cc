@@ -7,7 +7,7 @@ namespace paddock::runner {
 
 CarLink::CarLink(const car::CarParams& car)
     : car_(car),
-      socket_(car.host, 0),
+      socket_("0.0.0.0", 0),  // any interface: the car binary may be on another machine
       lidar_(hal::UdpSocket::address(car.host, car.lidar_port)),
       can_(hal::UdpSocket::address(car.host, car.can_port)),
       objects_(hal::UdpSocket::address(car.host, car.objects_port)) {}

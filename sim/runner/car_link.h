@@ -23,8 +23,8 @@ class CarLink {
   // a sync after this many LiDAR packets: the car takes them before more come
   static constexpr std::uint32_t kSyncEvery = 16;
 
-  // a socket of its own on [car] host, any free port; the car binary listens
-  // on the [car] ports
+  // a socket of its own (any interface, any free port); the car binary
+  // listens on [car] host and its ports
   explicit CarLink(const car::CarParams& car);
   // tells the car binary the run is over (it prints its summary and exits)
   ~CarLink();
