@@ -107,4 +107,18 @@ void BM_PlanPath_FSG2023_Within20m(benchmark::State& state) {
 }
 BENCHMARK(BM_PlanPath_FSG2023_Within20m)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
+// an open path as an autocross explores it with line = min_curvature (the
+// racing line: IPOPT on the path within the mapped boundaries, every plan):
+// the cones within 40 m of the start
+void BM_PlanPath_FSG2023_Within40m_RacingLine(benchmark::State& state) {
+  const Track t = read_track("fsg_2023");
+  std::vector<Cone> near;
+  for (const Cone& c : t.cones)
+    if (paddock::distance(c.position, t.start.position()) <= 40.0) near.push_back(c);
+  planning::PathPlannerParams params;
+  params.line = planning::PathPlannerParams::MinCurvature;
+  run_cycles(state, near, t.start, params);
+}
+BENCHMARK(BM_PlanPath_FSG2023_Within40m_RacingLine)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
 }  // namespace
