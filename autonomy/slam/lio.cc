@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_set>
+#include <unordered_map>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -450,16 +450,33 @@ LioStatus Lio::on_scan(const hal::LidarScan& scan) {
     propagate_to(std::max(t2, t_), &knots);
     slice_.assign(usable.begin() + static_cast<std::ptrdiff_t>(begin), usable.begin() + static_cast<std::ptrdiff_t>(end));
     std::vector<Vector3d> pts = deskew(slice_, imu_lidar_, knots);
-    // one point a leaf (the first of it, in time order)
+    // one point a leaf: the first of it in counter-clockwise azimuth order
+    // about the sensor's axis (ties, a column's rings within the float
+    // points' rounding: the first in time), whichever way the
+    // head spins. Time order is that order only for a counter-clockwise
+    // head; which edge of its leaf the kept point lies on moves the estimate
+    // (FSG 2023 autocross with barriers, LIO: a clockwise head kept the
+    // first in time order, the other edge, at ATE rms 0.05 m against 0.02 m)
     if (pr.scan_leaf > 0.0) {
-      std::unordered_set<std::uint64_t>& seen = leaf_seen_;
-      seen.clear();
-      std::vector<Vector3d> kept;
-      for (const Vector3d& q : pts) {
-        const auto cell = [&](double c) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(c / pr.scan_leaf)) & 0x1fffff); };
+      constexpr double kLeafAzimuthTie = 1e-5;  // rad
+      std::unordered_map<std::uint64_t, std::size_t>& best = leaf_best_;
+      best.clear();
+      leaf_azimuth_.resize(slice_.size());
+      for (std::size_t i = 0; i < slice_.size(); ++i) leaf_azimuth_[i] = std::atan2(slice_[i].y, slice_[i].x);
+      const auto cell = [&](double c) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(c / pr.scan_leaf)) & 0x1fffff); };
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const Vector3d& q = pts[i];
         const std::uint64_t key = cell(q.x()) | (cell(q.y()) << 21) | (cell(q.z()) << 42);
-        if (seen.insert(key).second) kept.push_back(q);
+        const auto [it, fresh] = best.emplace(key, i);
+        if (!fresh && leaf_azimuth_[i] < leaf_azimuth_[it->second] - kLeafAzimuthTie) it->second = i;
       }
+      // kept in time order
+      leaf_kept_.clear();
+      for (const auto& [key, i] : best) leaf_kept_.push_back(i);
+      std::sort(leaf_kept_.begin(), leaf_kept_.end());
+      std::vector<Vector3d> kept;
+      kept.reserve(leaf_kept_.size());
+      for (const std::size_t i : leaf_kept_) kept.push_back(pts[i]);
       pts.swap(kept);
     }
     ++stats_.slices;

@@ -81,7 +81,7 @@
 #include <cstdint>
 #include <deque>
 #include <string>
-#include <unordered_set>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -300,7 +300,9 @@ class Lio {
   };
   std::vector<Plane> planes_;  // update's, per point
   std::vector<hal::LidarPoint> slice_;        // on_scan's current slice
-  std::unordered_set<std::uint64_t> leaf_seen_;  // its down-sampling's leaves
+  std::unordered_map<std::uint64_t, std::size_t> leaf_best_;  // its down-sampling's leaves: the point kept
+  std::vector<double> leaf_azimuth_;                          // its points' azimuths (rad, sensor frame)
+  std::vector<std::size_t> leaf_kept_;                         // the kept points, in time order
 };
 
 }  // namespace paddock::slam

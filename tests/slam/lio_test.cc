@@ -156,16 +156,17 @@ LioExtrinsics extrinsics() {
   return e;
 }
 
-// one rotation from t0, each column from the IMU pose world_imu(t) at its time
+// one rotation from t0, each column from the IMU pose world_imu(t) at its
+// time; the head spins counter-clockwise, or clockwise (an Ouster's)
 template <class PoseAt>
 hal::LidarScan scan_of(const std::vector<Box>& boxes, bool ground, double t0, PoseAt world_imu,
-                       std::vector<Vector3d>* world_points = nullptr) {
+                       std::vector<Vector3d>* world_points = nullptr, bool clockwise = false) {
   hal::LidarScan scan;
   scan.stamp = from_seconds(t0);
   for (int c = 0; c < kColumns; ++c) {
     const double t = t0 + kPeriod * c / kColumns;
     const Isometry3d W = world_imu(t) * imu_lidar();
-    const double az = 2.0 * kPi * c / kColumns;
+    const double az = (clockwise ? -2.0 : 2.0) * kPi * c / kColumns;
     for (int r = 0; r < kRings; ++r) {
       const double el = (-15.0 + 30.0 * r / (kRings - 1)) * kPi / 180.0;
       const Vector3d d_l(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
@@ -360,6 +361,39 @@ TEST(Lio, DrivesACircleBetweenBarrierRingsWithoutDrift) {
   }
   std::printf("the same by least squares: worst %.4f m\n", plain_worst);
   EXPECT_GT(plain_worst, 2.0 * worst);
+}
+
+// the same circle with the head spinning either way: the LIO's down-sampling
+// keeps the same point of each leaf whichever way it spins (the first in
+// counter-clockwise azimuth order), so a clockwise head (an Ouster's) tracks
+// as well as a counter-clockwise one
+double circle_worst(bool clockwise) {
+  std::vector<Box> boxes;
+  for (const double ring : {15.0, 25.0}) {
+    const int n = static_cast<int>(2.0 * kPi * ring / 2.5);
+    for (int k = 0; k < n; ++k) {
+      const double a = 2.0 * kPi * k / n;
+      const Vector3d c(ring * std::sin(a), kRadius - ring * std::cos(a), 0.0);
+      boxes.push_back({c + Vector3d(-0.5, -0.5, 0.0), c + Vector3d(0.5, 0.5, 1.0)});
+    }
+  }
+  Lio lio(test_params(), extrinsics(), Pose2{});
+  const double T = 30.0;
+  for (int k = 0; k <= static_cast<int>((T + 0.5) * kImuRate); ++k) lio.on_imu(circle_imu(k / kImuRate));
+  lio.reset(circle_state(0.0), 0);
+  double worst = 0.0;
+  for (int s = 0; s < static_cast<int>(T / kPeriod); ++s) {
+    lio.on_scan(scan_of(boxes, true, s * kPeriod, circle_pose, nullptr, clockwise));
+    worst = std::max(worst, (lio.state().p - circle_pose(to_seconds(lio.stamp())).translation()).norm());
+  }
+  return worst;
+}
+
+TEST(Lio, AClockwiseHeadTracksAsACounterClockwiseOneDoes) {
+  const double ccw = circle_worst(false), cw = circle_worst(true);
+  std::printf("circle between barrier rings: worst %.4f m counter-clockwise, %.4f m clockwise\n", ccw, cw);
+  EXPECT_LT(cw, 0.08);
+  EXPECT_LT(cw, 1.5 * ccw + 0.005);
 }
 
 TEST(Lio, BadSamplesAndPointsAreCountedAndIgnored) {
