@@ -175,9 +175,14 @@ void Stack::learn_gates(const Pose2& pose, TimeNs now, double speed) {
       }
       continue;
     }
-    // a new gate lies across the path ahead, and is oriented by the heading of the car that sees it
-    if (std::abs(project(trajectory_, mid, 0.0, 0.0).offset) > mp.gate_max_offset) continue;
-    gates_.push_back(orient_gate(g, pose.heading()));
+    // a new gate lies across the path ahead, and is oriented by the path's
+    // heading where it passes the gate: the car's own heading, far from the
+    // gate, may lie along the line or against it (a gate seen again from
+    // across the track, 44 m away, was stored back to front and never
+    // counted a lap again)
+    const TrajectoryProjection through = project(trajectory_, mid, 0.0, 0.0);
+    if (std::abs(through.offset) > mp.gate_max_offset) continue;
+    gates_.push_back(orient_gate(g, unit_from_angle(through.ref.heading)));
   }
 }
 
