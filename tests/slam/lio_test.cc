@@ -320,17 +320,23 @@ TEST(Lio, AFlatGroundAloneIsReportedDegenerate) {
 // (16 rings, 720 columns): 0.056 m and 1.1 mrad at worst with Huber's loss;
 // 0.19 m and 8 mrad by plain least squares, whose planes fitted across a
 // block's foot (ground and face points on one tilted plane) pull the state
-TEST(Lio, DrivesACircleBetweenBarrierRingsWithoutDrift) {
+// two rings of barrier blocks, 15 m and 25 m from the circle's centre: axis-
+// aligned blocks (the slab caster's), about 1 m square, 1 m high, 2.5 m apart
+std::vector<Box> barrier_rings() {
   std::vector<Box> boxes;
   for (const double ring : {15.0, 25.0}) {
     const int n = static_cast<int>(2.0 * kPi * ring / 2.5);
     for (int k = 0; k < n; ++k) {
       const double a = 2.0 * kPi * k / n;
       const Vector3d c(ring * std::sin(a), kRadius - ring * std::cos(a), 0.0);
-      // axis-aligned blocks (the slab caster's): about 1 m square, 1 m high
       boxes.push_back({c + Vector3d(-0.5, -0.5, 0.0), c + Vector3d(0.5, 0.5, 1.0)});
     }
   }
+  return boxes;
+}
+
+TEST(Lio, DrivesACircleBetweenBarrierRingsWithoutDrift) {
+  const std::vector<Box> boxes = barrier_rings();
   LioParams p = test_params();
   Lio lio(p, extrinsics(), Pose2{});
   const double T = 30.0;
@@ -368,15 +374,7 @@ TEST(Lio, DrivesACircleBetweenBarrierRingsWithoutDrift) {
 // counter-clockwise azimuth order), so a clockwise head (an Ouster's) tracks
 // as well as a counter-clockwise one
 double circle_worst(bool clockwise) {
-  std::vector<Box> boxes;
-  for (const double ring : {15.0, 25.0}) {
-    const int n = static_cast<int>(2.0 * kPi * ring / 2.5);
-    for (int k = 0; k < n; ++k) {
-      const double a = 2.0 * kPi * k / n;
-      const Vector3d c(ring * std::sin(a), kRadius - ring * std::cos(a), 0.0);
-      boxes.push_back({c + Vector3d(-0.5, -0.5, 0.0), c + Vector3d(0.5, 0.5, 1.0)});
-    }
-  }
+  const std::vector<Box> boxes = barrier_rings();
   Lio lio(test_params(), extrinsics(), Pose2{});
   const double T = 30.0;
   for (int k = 0; k <= static_cast<int>((T + 0.5) * kImuRate); ++k) lio.on_imu(circle_imu(k / kImuRate));
