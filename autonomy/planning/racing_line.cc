@@ -4,18 +4,13 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
-#include <utility>
 
 #include <ceres/ceres.h>
-#include <IpIpoptApplication.hpp>
-#include <IpSolveStatistics.hpp>
-#include <IpTNLP.hpp>
 
 #include "autonomy/common/polyline.h"
+#include "autonomy/planning/interior_point.h"
 
 namespace paddock::planning {
 
@@ -79,149 +74,52 @@ constexpr int kClearanceRounds = 4;
 // m: a shortfall smaller than this is left alone
 constexpr double kClearanceTolerance = 0.005;
 
-// the problem for IPOPT: minimise f(a) = sum_k r_k(a)^2 within the bounds,
-// no other constraints. Each residual r_k touches three neighbouring offsets;
-// its gradient comes from Ceres' automatic differentiation. The Hessian
-// given is the Gauss-Newton one, 2 sum_k J_k^T J_k (positive semi-definite,
-// the curvature residuals' own second derivatives left out), a band of
-// width 2 round the loop.
-class MinCurvatureNlp : public Ipopt::TNLP {
+// the cost as sum_k r_k(a)^2 for the interior-point solver: one Menger
+// residual per inner point, a function of its offset and its neighbours',
+// its gradient from Ceres' automatic differentiation
+class MengerTerms : public SparseLeastSquares {
  public:
-  using Index = Ipopt::Index;
-  using Number = Ipopt::Number;
-
-  MinCurvatureNlp(const std::vector<Vec2>& r, const std::vector<Vec2>& normal, bool closed,
-                  const std::vector<double>& lower, const std::vector<double>& upper, std::vector<double>& offset)
-      : lower_(lower), upper_(upper), offset_(offset) {
+  MengerTerms(const std::vector<Vec2>& r, const std::vector<Vec2>& normal, bool closed) {
     const std::size_t n = r.size();
     for (std::size_t i = closed ? 0 : 1; i < (closed ? n : n - 1); ++i) {
       const std::size_t a = (i + n - 1) % n, c = (i + 1) % n;
-      residuals_.push_back({{a, i, c},
-                            std::make_unique<ceres::AutoDiffCostFunction<MengerResidual, 1, 1, 1, 1>>(
-                                new MengerResidual{r[a], r[i], r[c], normal[a], normal[i], normal[c]})});
-    }
-    // the Hessian's lower triangle: every pair of offsets one residual joins
-    for (Residual& res : residuals_) {
-      for (int p = 0; p < 3; ++p) {
-        for (int q = 0; q < 3; ++q) {
-          const std::size_t i = res.index[p], j = res.index[q];
-          if (i < j) continue;
-          const auto [it, added] = hessian_slot_.try_emplace({i, j}, hessian_slot_.size());
-          res.slot[p][q] = it->second;
-        }
-      }
+      terms_.push_back({{static_cast<int>(a), static_cast<int>(i), static_cast<int>(c)},
+                        std::make_unique<ceres::AutoDiffCostFunction<MengerResidual, 1, 1, 1, 1>>(
+                            new MengerResidual{r[a], r[i], r[c], normal[a], normal[i], normal[c]})});
     }
   }
 
-  bool get_nlp_info(Index& n, Index& m, Index& nnz_jac_g, Index& nnz_h_lag, IndexStyleEnum& style) override {
-    n = static_cast<Index>(offset_.size());
-    m = 0;
-    nnz_jac_g = 0;
-    nnz_h_lag = static_cast<Index>(hessian_slot_.size());
-    style = C_STYLE;
-    return true;
-  }
-  bool get_bounds_info(Index n, Number* x_l, Number* x_u, Index, Number*, Number*) override {
-    for (Index i = 0; i < n; ++i) x_l[i] = lower_[static_cast<std::size_t>(i)], x_u[i] = upper_[static_cast<std::size_t>(i)];
-    return true;
-  }
-  bool get_starting_point(Index n, bool, Number* x, bool, Number*, Number*, Index, bool, Number*) override {
-    std::copy(offset_.begin(), offset_.begin() + n, x);
-    return true;
-  }
-  bool eval_f(Index, const Number* x, bool, Number& f) override {
-    f = 0.0;
-    for (const Residual& res : residuals_) {
-      const double r = evaluate(res, x, nullptr);
-      f += r * r;
-    }
-    return std::isfinite(f);
-  }
-  bool eval_grad_f(Index n, const Number* x, bool, Number* grad) override {
-    std::fill(grad, grad + n, 0.0);
-    double j[3];
-    for (const Residual& res : residuals_) {
-      const double r = evaluate(res, x, j);
-      for (int p = 0; p < 3; ++p) grad[res.index[p]] += 2.0 * r * j[p];
-    }
-    return true;
-  }
-  bool eval_g(Index, const Number*, bool, Index, Number*) override { return true; }
-  bool eval_jac_g(Index, const Number*, bool, Index, Index, Index*, Index*, Number*) override { return true; }
-  bool eval_h(Index, const Number* x, bool, Number obj_factor, Index, const Number*, bool, Index nele, Index* row,
-              Index* col, Number* values) override {
-    if (values == nullptr) {
-      for (const auto& [pair, slot] : hessian_slot_) {
-        row[slot] = static_cast<Index>(pair.first);
-        col[slot] = static_cast<Index>(pair.second);
-      }
-      return true;
-    }
-    std::fill(values, values + nele, 0.0);
-    double j[3];
-    for (const Residual& res : residuals_) {
-      evaluate(res, x, j);
-      for (int p = 0; p < 3; ++p)
-        for (int q = 0; q < 3; ++q)
-          if (res.index[p] >= res.index[q]) values[res.slot[p][q]] += obj_factor * 2.0 * j[p] * j[q];
-    }
-    return true;
-  }
-  void finalize_solution(Ipopt::SolverReturn, Index n, const Number* x, const Number*, const Number*, Index,
-                         const Number*, const Number*, Number, const Ipopt::IpoptData*,
-                         Ipopt::IpoptCalculatedQuantities*) override {
-    std::copy(x, x + n, offset_.begin());
+  std::size_t residuals() const override { return terms_.size(); }
+  std::size_t arity(std::size_t) const override { return 3; }
+  const int* variables(std::size_t k) const override { return terms_[k].index; }
+  double residual(std::size_t k, const double* x, double* jacobian) const override {
+    const Term& t = terms_[k];
+    const double* params[3] = {&x[t.index[0]], &x[t.index[1]], &x[t.index[2]]};
+    double* jac[3] = {jacobian, jacobian ? jacobian + 1 : nullptr, jacobian ? jacobian + 2 : nullptr};
+    double value = 0.0;
+    if (!t.cost->Evaluate(params, &value, jacobian ? jac : nullptr)) return std::numeric_limits<double>::quiet_NaN();
+    return value;
   }
 
  private:
-  struct Residual {
-    std::size_t index[3];
+  struct Term {
+    int index[3];
     std::unique_ptr<ceres::CostFunction> cost;
-    std::size_t slot[3][3] = {};
   };
-
-  // r_k, and its gradient with respect to its three offsets when j is given
-  static double evaluate(const Residual& res, const Number* x, double* j) {
-    const double* params[3] = {&x[res.index[0]], &x[res.index[1]], &x[res.index[2]]};
-    double r = 0.0;
-    double* jac[3] = {j, j ? j + 1 : nullptr, j ? j + 2 : nullptr};
-    res.cost->Evaluate(params, &r, j ? jac : nullptr);
-    return r;
-  }
-
-  const std::vector<double>& lower_;
-  const std::vector<double>& upper_;
-  std::vector<double>& offset_;
-  std::vector<Residual> residuals_;
-  std::map<std::pair<std::size_t, std::size_t>, std::size_t> hessian_slot_;
+  std::vector<Term> terms_;
 };
 
-// one solve from `offset` (within the bounds); returns IPOPT's iterations,
-// -1 when it failed (the offsets are then left as they were)
-int solve(const std::vector<Vec2>& r, const std::vector<Vec2>& normal, bool closed, int max_iterations,
-          const std::vector<double>& lower, const std::vector<double>& upper, std::vector<double>& offset) {
-  // IPOPT's linear solver (Debian's sequential MUMPS) keeps global state: one
-  // solve at a time in a process, whose sweep and tune runs are threads and
-  // whose runs solve their limit lap on a thread of its own
-  static std::mutex one_at_a_time;
-  const std::lock_guard<std::mutex> lock(one_at_a_time);
+// one solve from `offset` (within the bounds); returns the Newton
+// iterations, -1 when it failed (the offsets are then left as they were)
+int solve(const MengerTerms& terms, int max_iterations, const std::vector<double>& lower,
+          const std::vector<double>& upper, std::vector<double>& offset) {
   std::vector<double> x = offset;
-  Ipopt::SmartPtr<MinCurvatureNlp> nlp = new MinCurvatureNlp(r, normal, closed, lower, upper, x);
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  app->Options()->SetIntegerValue("print_level", 0);
-  app->Options()->SetStringValue("sb", "yes");  // no banner
-  app->Options()->SetIntegerValue("max_iter", max_iterations);
-  app->Options()->SetNumericValue("tol", 1e-10);
-  app->Options()->SetStringValue("mu_strategy", "adaptive");
-  app->Options()->SetStringValue("honor_original_bounds", "yes");
-  if (app->Initialize() != Ipopt::Solve_Succeeded) return -1;
-  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(Ipopt::SmartPtr<Ipopt::TNLP>(GetRawPtr(nlp)));
-  const bool usable = status == Ipopt::Solve_Succeeded || status == Ipopt::Solved_To_Acceptable_Level ||
-                      status == Ipopt::Maximum_Iterations_Exceeded;
-  if (!usable || !std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); })) return -1;
-  for (std::size_t i = 0; i < x.size(); ++i) offset[i] = std::clamp(x[i], lower[i], upper[i]);
-  Ipopt::SmartPtr<Ipopt::SolveStatistics> stats = app->Statistics();
-  return IsValid(stats) ? stats->IterationCount() : 0;
+  InteriorPointOptions options;
+  options.max_iterations = max_iterations;
+  const InteriorPointResult result = minimise_within_bounds(terms, lower, upper, x, options);
+  if (!result.usable() || !std::all_of(x.begin(), x.end(), [](double v) { return std::isfinite(v); })) return -1;
+  offset = x;
+  return result.iterations;
 }
 
 }  // namespace
@@ -306,8 +204,9 @@ RacingLine min_curvature_line(const std::vector<Vec2>& reference, const std::vec
   // shortfall and the problem solved again from there (a few rounds)
   out.offset.assign(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) out.offset[i] = std::clamp(0.0, out.lower[i], out.upper[i]);
+  const MengerTerms terms(r, normal, closed);
   for (int round = 0; round < kClearanceRounds; ++round) {
-    const int iterations = solve(r, normal, closed, params.max_iterations, out.lower, out.upper, out.offset);
+    const int iterations = solve(terms, params.max_iterations, out.lower, out.upper, out.offset);
     if (iterations < 0) {
       out.reason = "racing line: the optimiser failed";
       return out;

@@ -13,12 +13,14 @@
 // lo_i and hi_i keep p_i `clearance` from the right and left boundary along
 // the normal. The cost is the sum over i of kappa_i^2 ds_i with kappa_i the
 // curvature of the circle through p_i-1, p_i, p_i+1 (Menger curvature), a
-// smooth non-linear least-squares problem with bounds, solved with IPOPT
-// (interior point; Gauss-Newton Hessian, gradients by Ceres' automatic
-// differentiation) from the reference (a_i = 0). An interior-point method
-// because a line pressed against a boundary of cones is pressed against
-// many facets at once: Ceres' bounded Levenberg-Marquardt, which projects
-// each step onto the box, stalls there with the line following the facets.
+// smooth non-linear least-squares problem with bounds, solved by a
+// primal-dual interior-point method (IPOPT's algorithm specialised to
+// bounds, interior_point.h; Gauss-Newton Hessian, gradients by Ceres'
+// automatic differentiation) from the reference (a_i = 0). An
+// interior-point method because a line pressed against a boundary of
+// cones is pressed against many facets at once: Ceres' bounded
+// Levenberg-Marquardt, which projects each step onto the box, stalls there
+// with the line following the facets.
 // The bounds are distances along the normals; where the Euclidean
 // distance of a solved point to a boundary falls short of the clearance
 // (the boundary bends towards it), that bound is tightened and the problem
