@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -108,6 +109,46 @@ TEST(AnnotationDetector, NoErrorsGivesTheTightBoxesAndClasses) {
   EXPECT_EQ(r.boxes[2].y_max, 86.0);
   EXPECT_EQ(r.boxes[2].color, ConeColor::BigOrange);
   EXPECT_DOUBLE_EQ(r.boxes[0].confidence, 1.0);
+}
+
+TEST(AnnotationDetector, TightBoxesAgreeWithABruteForceScanOfScatteredLabels) {
+  // single labelled pixels and small blobs at random places (row ends, block
+  // edges, a width no multiple of 16): each box and pixel count as a plain
+  // min/max over every pixel gives it
+  std::mt19937 rng(11);
+  for (const int w : {37, 64, 803}) {
+    AnnotatedFrame f = blank(w, 23);
+    const int ids = 6;
+    for (int id = 0; id < ids; ++id) f.annotation.instances.push_back(CameraInstance{id, ConeColor::Blue, 5.0, 1.0});
+    std::uniform_int_distribution<int> col(0, w - 1), row(0, 22), which(0, ids - 2), size(0, 2);
+    for (int k = 0; k < 60; ++k) {
+      const int i = col(rng), j = row(rng), s = size(rng);
+      paint(f, which(rng), i, std::min(w - 1, i + s), j, std::min(22, j + s));
+    }
+    // the last instance: one pixel in the last column
+    paint(f, ids - 1, w - 1, w - 1, 22, 22);
+    std::string error;
+    const std::vector<TightBox> boxes = tight_boxes(f.frame, f.annotation, &error);
+    ASSERT_TRUE(error.empty()) << error;
+    ASSERT_EQ(boxes.size(), static_cast<std::size_t>(ids));
+    for (int id = 0; id < ids; ++id) {
+      int i_min = w, i_max = -1, j_min = 23, j_max = -1, pixels = 0;
+      for (int j = 0; j < 23; ++j)
+        for (int i = 0; i < w; ++i)
+          if (f.annotation.labels[static_cast<std::size_t>(j) * w + i] == id) {
+            i_min = std::min(i_min, i), i_max = std::max(i_max, i), j_min = std::min(j_min, j), j_max = std::max(j_max, j);
+            ++pixels;
+          }
+      const TightBox& b = boxes[static_cast<std::size_t>(id)];
+      EXPECT_EQ(b.id, id);
+      EXPECT_EQ(b.pixels, pixels) << w << " " << id;
+      if (pixels == 0) continue;
+      EXPECT_EQ(b.i_min, i_min) << w << " " << id;
+      EXPECT_EQ(b.i_max, i_max) << w << " " << id;
+      EXPECT_EQ(b.j_min, j_min) << w << " " << id;
+      EXPECT_EQ(b.j_max, j_max) << w << " " << id;
+    }
+  }
 }
 
 TEST(AnnotationDetector, MissCurveIsTheDocumentedOne) {
