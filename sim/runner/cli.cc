@@ -12,6 +12,7 @@
 
 #include "autonomy/common/format.h"
 #include "render/figures.h"
+#include "sim/runner/bench_compare.h"
 #include "sim/runner/files.h"
 #include "sim/runner/plots.h"
 #include "sim/runner/limit_report.h"
@@ -42,6 +43,9 @@ const char* kUsage =
     "      --log writes DIR/run.mcap (a wire run: the LiDAR's packets, the CAN frames,\n"
     "      the stack's outputs in Foxglove's schemas).\n"
     "      Exit 3 when [expect] fails.\n"
+    "  paddock bench-compare OLD.json NEW.json   (./paddock bench compare OLD.json NEW.json)\n"
+    "      two runs of the benchmarks (./paddock bench --json FILE) side by side: each\n"
+    "      one's CPU time per iteration and NEW/OLD, SLOWER past 1.10 (then exit 1)\n"
     "  paddock replay LOG.mcap [--set section.key=value]... [--from S] [--until S]\n"
     "      reruns the stack on a run's log (paddock run ... --log) without the simulator:\n"
     "      the recorded packets and frames through the car's decoders. Unchanged it gives\n"
@@ -577,6 +581,12 @@ int run_cli(const std::vector<std::string>& args) {
     if (args[0] == "sweep") return cmd_sweep(rest);
     if (args[0] == "tune") return cmd_tune(rest);
     if (args[0] == "report") return cmd_report(rest);
+    if (args[0] == "bench-compare") {
+      if (rest.size() != 2) throw UserError("bench-compare needs OLD.json NEW.json\n" + std::string(kUsage));
+      const BenchComparison c = compare_benchmarks(read_bench_json(rest[0]), read_bench_json(rest[1]));
+      std::cout << bench_comparison_text(c);
+      return c.slower > 0 ? 1 : 0;
+    }
     if (args[0] == "keys") {
       if (!rest.empty()) throw UserError("keys takes no arguments\n" + std::string(kUsage));
       std::cout << keys_markdown();
