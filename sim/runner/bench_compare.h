@@ -11,8 +11,7 @@ namespace paddock::runner {
 
 struct BenchTiming {
   std::string name;
-  double real_ns = 0.0;  // per iteration, in nanoseconds
-  double cpu_ns = 0.0;
+  double cpu_ns = 0.0;  // CPU time per iteration, in nanoseconds
 };
 
 struct BenchRow {
