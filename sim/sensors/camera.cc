@@ -95,6 +95,13 @@ Camera::Camera(const CameraParams& params, std::uint64_t seed)
   sun_[2] = std::sin(params_.sun_elevation);
   sky_rgb_ = {to_byte(params_.sky.r), to_byte(params_.sky.g), to_byte(params_.sky.b)};
   ground_rgb_ = shade(params_.ground, std::max(0.0, sun_[2]));
+  // a row of sky and a row of flat ground, copied into each frame's rows
+  sky_row_.resize(3 * w);
+  ground_row_.resize(3 * w);
+  for (std::size_t i = 0; i < w; ++i) {
+    std::copy(sky_rgb_.begin(), sky_rgb_.end(), sky_row_.begin() + 3 * static_cast<std::ptrdiff_t>(i));
+    std::copy(ground_rgb_.begin(), ground_rgb_.end(), ground_row_.begin() + 3 * static_cast<std::ptrdiff_t>(i));
+  }
   stamp_.assign(w * h, 0);
   cover_.assign(w * h, 0);
   reach_.assign(w * h, 0.0f);
@@ -200,7 +207,16 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   out.width = W;
   out.height = H;
   out.rgb.resize(3 * n_px);
-  annotation.labels.assign(n_px, -1);
+  // the labels: -1 everywhere; when the buffer is the one this camera wrote
+  // last frame (as the runner passes it), only the pixels it labelled then
+  // differ from that
+  if (annotation.labels.size() == n_px && annotation.labels.data() == labels_buffer_) {
+    for (std::uint32_t p : labelled_) annotation.labels[p] = -1;
+  } else {
+    annotation.labels.assign(n_px, -1);
+  }
+  labels_buffer_ = annotation.labels.data();
+  labelled_.clear();
   annotation.instances.clear();
   last_primary_rays_ = last_continued_rays_ = 0;
   if (!finite(base_pose.x) || !finite(base_pose.y) || !finite(base_pose.yaw)) {
@@ -231,13 +247,8 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   // all point up (sky) or all down (flat ground)
   for (int j = 0; j < H; ++j) {
     const double dz = by_[static_cast<std::size_t>(j)] * col[1][2] + col[2][2];
-    const std::array<std::uint8_t, 3>& c = (flat_ground && dz < 0.0) ? ground_rgb_ : sky_rgb_;
-    std::uint8_t* row = out.rgb.data() + 3 * static_cast<std::size_t>(j) * static_cast<std::size_t>(W);
-    for (int i = 0; i < W; ++i) {
-      row[3 * i] = c[0];
-      row[3 * i + 1] = c[1];
-      row[3 * i + 2] = c[2];
-    }
+    const std::vector<std::uint8_t>& row = (flat_ground && dz < 0.0) ? ground_row_ : sky_row_;
+    std::copy(row.begin(), row.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(j) * W);
   }
 
   // the cones' boxes: project each cone's 3D box (clipped at the near plane),
@@ -418,6 +429,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
     std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
     if (cone >= 0) {
       annotation.labels[p] = cone;
+      labelled_.push_back(p);
       ++visible_[static_cast<std::size_t>(cone)];
       ++unoccluded_[static_cast<std::size_t>(cone)];
       if (cover_[p] < 2) return;  // no other cone's box: nothing behind to count

@@ -215,7 +215,9 @@ class Camera {
   // pose gives a black frame with no labelled pixel and no instance.
   AnnotatedFrame render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp);
   // the same into `out` and `annotation`, reusing their buffers (no
-  // allocation once sized)
+  // allocation once sized). When annotation.labels is the buffer of this
+  // camera's last call, unchanged since, only the pixels it labelled then
+  // are reset (anything else must not write into it)
   void render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp, hal::CameraFrame& out,
               CameraAnnotation& annotation);
 
@@ -247,6 +249,7 @@ class Camera {
   // sun direction (world), analytic ground colour (flat), sky colour
   double sun_[3] = {0, 0, 1};
   std::array<std::uint8_t, 3> sky_rgb_{}, ground_rgb_{};
+  std::vector<std::uint8_t> sky_row_, ground_row_;  // a row of each, RGB
   std::vector<std::int16_t> noise_;    // pixel noise quantiles (empty: no noise)
   // buffers reused between frames
   std::vector<ConeGeom> cones_;        // cones of the scene
@@ -262,6 +265,8 @@ class Camera {
   std::vector<std::int32_t> visible_, unoccluded_;  // per cone index
   std::vector<std::int32_t> boxed_;    // cones with a box in the image this frame
   std::uint32_t frame_ = 0;
+  const std::int32_t* labels_buffer_ = nullptr;  // the labels buffer of the last frame
+  std::vector<std::uint32_t> labelled_;          // and its pixels >= 0
   std::size_t last_primary_rays_ = 0, last_continued_rays_ = 0;
 };
 
