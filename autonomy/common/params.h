@@ -199,6 +199,57 @@ std::vector<std::string> field_paths(const P& p) {
   return l.paths;
 }
 
+// every field of p (and of the structs nested in it) as "path=value" lines,
+// numbers exactly (number(): the shortest text that reads back the same):
+// two structs with the same text hold the same values (a cache key)
+class Fingerprinter {
+ public:
+  std::string text;
+
+  template <class T>
+  void operator()(const char* key, T& field, const Spec&) {
+    if constexpr (detail::is_optional<T>::value) {
+      add(key, field ? number(static_cast<double>(*field)) : std::string("unset"));
+    } else {
+      add(key, number(static_cast<double>(field)));
+    }
+  }
+  template <class T>
+  void operator()(const char* key, std::vector<T>& list, const Spec& spec) {
+    add(key, "list of " + std::to_string(list.size()));
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const std::string item = std::string(key) + "[" + std::to_string(i) + "]";
+      (*this)(item.c_str(), list[i], spec);
+    }
+  }
+  template <class E, std::size_t N>
+  void operator()(const char* key, E& field, const Choice<E> (&)[N], const char*) {
+    add(key, std::to_string(static_cast<long long>(field)));
+  }
+  void operator()(const char* key, bool& b, const char*) { add(key, b ? "true" : "false"); }
+  void operator()(const char* key, std::optional<bool>& b, const char*) { add(key, b ? (*b ? "true" : "false") : "unset"); }
+  void operator()(const char* key, std::string& s, const char*) { add(key, std::to_string(s.size()) + ":" + s); }
+  template <class P>
+  void section(const char* key, P& sub, const char*) {
+    const std::size_t size = prefix_.size();
+    prefix_ += key;
+    prefix_ += '.';
+    sub.visit(*this);
+    prefix_.resize(size);
+  }
+
+ private:
+  void add(const char* key, const std::string& value) { text += prefix_ + key + "=" + value + "\n"; }
+  std::string prefix_;
+};
+
+template <class P>
+std::string fingerprint(const P& p) {
+  Fingerprinter f;
+  const_cast<P&>(p).visit(f);  // reads only
+  return f.text;
+}
+
 // "" when every field of p (and of every struct nested in it) lies in its
 // bounds and every check() passes, else the first problem, starting with the
 // field's path ("clustering.tolerance must be > 0 m (got -1)")

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <exception>
+#include <future>
+#include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -74,6 +78,32 @@ planning::VelocityProfileParams car_envelope(const vehicle::VehicleParams& car, 
   planning::VelocityProfileParams e = ggv_envelope(m.rows, m.top_speed);
   if (measured) *measured = std::move(m);
   return e;
+}
+
+planning::VelocityProfileParams shared_car_envelope(const vehicle::VehicleParams& car) {
+  static std::mutex mutex;
+  static std::map<std::string, std::shared_future<planning::VelocityProfileParams>> measured;
+  const std::string key = params::fingerprint(car);
+  std::promise<planning::VelocityProfileParams> promise;
+  std::shared_future<planning::VelocityProfileParams> future;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    const auto it = measured.find(key);
+    if (it != measured.end()) {
+      future = it->second;
+    } else {
+      measured.emplace(key, promise.get_future().share());
+    }
+  }
+  if (future.valid()) return future.get();  // measured, or being measured
+  try {
+    const planning::VelocityProfileParams e = car_envelope(car);
+    promise.set_value(e);
+    return e;
+  } catch (...) {
+    promise.set_exception(std::current_exception());
+    throw;
+  }
 }
 
 LimitReport limit_report(const vehicle::VehicleParams& car, const world::TrackModel& track,

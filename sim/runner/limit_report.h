@@ -49,6 +49,12 @@ LimitLines limit_lines(const world::TrackModel& track, const planning::VelocityP
 
 // the car's envelope as the QSS uses it: measure_ggv, then ggv_envelope
 planning::VelocityProfileParams car_envelope(const vehicle::VehicleParams& car, GgvMeasurement* measured = nullptr);
+// the same, measured once per process and car (params::fingerprint of its
+// parameters): the points of a sweep in one process share their car's
+// (~2 s of CPU each on the default car). Thread-safe; a second caller for
+// a car being measured waits for that measurement; an exception is
+// rethrown to every caller
+planning::VelocityProfileParams shared_car_envelope(const vehicle::VehicleParams& car);
 
 struct LimitReport {
   std::string scenario;                    // the scenario file

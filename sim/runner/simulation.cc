@@ -238,12 +238,13 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
               WireTap* tap) {
   const auto wall0 = std::chrono::steady_clock::now();
   // the limit lap, on a second thread while the run goes on: it reads only
-  // the vehicle's parameters and the track
+  // the vehicle's parameters and the track (the car's envelope measured once
+  // per process: a sweep's points share it)
   std::future<std::optional<LimitLines>> limit;
   if (track.kind == world::TrackKind::Circuit && track.closed) {
     limit = std::async(std::launch::async, [&scenario, &track]() -> std::optional<LimitLines> {
       try {
-        return limit_lines(track, car_envelope(scenario.vehicle));
+        return limit_lines(track, shared_car_envelope(scenario.vehicle));
       } catch (const std::exception&) {
         return std::nullopt;
       }

@@ -139,5 +139,29 @@ TEST(Params, AVisitorSeesEveryFieldOnceInDeclarationOrder) {
   EXPECT_EQ(field_paths(Outer{}), (std::vector<std::string>{"share", "flag", "mode", "limit", "edges", "inner.gain", "inner.count"}));
 }
 
+// the fingerprint is a cache key: the same values give the same text, a
+// change of any one field (nested, in a list, an optional set or unset, the
+// last bit of a double) gives another
+TEST(Params, FingerprintsDifferInEveryFieldAndAgreeOnEqualValues) {
+  const Outer base;
+  EXPECT_EQ(fingerprint(base), fingerprint(Outer{}));
+  EXPECT_EQ(fingerprint(base), "share=0.5\nflag=true\nmode=0\nlimit=unset\nedges=list of 2\nedges[0]=1\nedges[1]=2\n"
+                               "inner.gain=1\ninner.count=3\n");
+  std::vector<Outer> changed(9);
+  changed[0].share = std::nextafter(0.5, 1.0);
+  changed[1].flag = false;
+  changed[2].mode = Mode::B;
+  changed[3].limit = 0.0;
+  changed[4].edges.push_back(3.0);
+  changed[5].edges[1] = 2.5;
+  changed[6].inner.gain = 1.5;
+  changed[7].inner.count = 4;
+  changed[8].edges = {1.0};
+  for (std::size_t i = 0; i < changed.size(); ++i) {
+    EXPECT_NE(fingerprint(changed[i]), fingerprint(base)) << i;
+    for (std::size_t j = 0; j < i; ++j) EXPECT_NE(fingerprint(changed[i]), fingerprint(changed[j])) << i << " " << j;
+  }
+}
+
 }  // namespace
 }  // namespace paddock::params

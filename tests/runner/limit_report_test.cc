@@ -12,6 +12,9 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include "autonomy/common/polyline.h"
 #include "sim/runner/files.h"
@@ -117,6 +120,27 @@ TEST(LimitReport, FsgLinesRespectTheEnvelopeAndTheClearance) {
   // the envelope grows with speed (downforce) and loses acceleration to drag
   EXPECT_GT(r.envelope.ggv_lateral.back(), r.envelope.ggv_lateral.front());
   EXPECT_EQ(r.envelope.ggv_accel.back(), 0.0);
+}
+
+// a sweep's points share their car's envelope, measured once per process:
+// callers on three threads at once get what a measurement of their own
+// gives, and another car gets its own
+TEST(SharedCarEnvelope, IsTheCarsOwnMeasurementForEveryCaller) {
+  const Scenario s = load_scenario(kRoot + "/scenarios/fsg_2023_trackdrive.ini");
+  std::vector<std::string> got(3);
+  std::vector<std::thread> threads;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    threads.emplace_back([&, i] { got[i] = params::fingerprint(shared_car_envelope(s.vehicle)); });
+  }
+  for (std::thread& t : threads) t.join();
+  const std::string own = params::fingerprint(car_envelope(s.vehicle));
+  for (const std::string& g : got) EXPECT_EQ(g, own);
+  vehicle::VehicleParams heavier = s.vehicle;
+  heavier.mass *= 1.25;
+  const std::string heavy = params::fingerprint(shared_car_envelope(heavier));
+  EXPECT_NE(heavy, own);
+  EXPECT_EQ(params::fingerprint(shared_car_envelope(heavier)), heavy);
+  EXPECT_EQ(params::fingerprint(shared_car_envelope(s.vehicle)), own);
 }
 
 TEST(GgvEnvelope, NodesFromTheRowsAndTheGripLineUnderTheLock) {
