@@ -34,6 +34,14 @@ void* operator new(std::size_t n) {
 }
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+// the nothrow pair too (std::stable_sort's buffer): whatever this binary's
+// deletes free must come from this malloc (AddressSanitizer, which has its
+// own nothrow new, reported the mismatch)
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  return std::malloc(n == 0 ? 1 : n);
+}
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
 
 namespace paddock::slam {
 namespace {
