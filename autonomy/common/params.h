@@ -110,9 +110,30 @@ std::string check_of(const P& p) {
   else return "";
 }
 
+// what the visitors below share: the path of the section being visited,
+// with a trailing '.' ("ground."), kept while a nested struct is visited
+class SectionPath {
+ protected:
+  // sub's fields visited by v under key's path; then after(), still there
+  template <class V, class P, class After>
+  void descend(V& v, const char* key, P& sub, After after) {
+    const std::size_t size = prefix_.size();
+    prefix_ += key;
+    prefix_ += '.';
+    sub.visit(v);
+    after();
+    prefix_.resize(size);
+  }
+  template <class V, class P>
+  void descend(V& v, const char* key, P& sub) {
+    descend(v, key, sub, [] {});
+  }
+  std::string prefix_;
+};
+
 // the first field (depth first, in declaration order) outside its bounds, or
 // the first check() that fails; "" when all is well
-class Validator {
+class Validator : SectionPath {
  public:
   const std::string& problem() const { return problem_; }
 
@@ -149,25 +170,20 @@ class Validator {
   template <class P>
   void section(const char* key, P& sub, const char*) {
     if (!problem_.empty()) return;
-    const std::size_t size = prefix_.size();
-    prefix_ += key;
-    prefix_ += '.';
-    sub.visit(*this);
-    if (problem_.empty()) {
+    descend(*this, key, sub, [&] {
+      if (!problem_.empty()) return;
       const std::string why = check_of(sub);
       if (!why.empty()) problem_ = prefix_ + why;
-    }
-    prefix_.resize(size);
+    });
   }
 
  private:
   std::string problem_;
-  std::string prefix_;  // the path of the section being visited, with a trailing '.'
 };
 
 // the path of every field of p (and of the structs nested in it), in
 // declaration order: "tolerance", "ground.max_slope", ...
-class PathLister {
+class PathLister : SectionPath {
  public:
   std::vector<std::string> paths;
 
@@ -180,16 +196,11 @@ class PathLister {
   void operator()(const char* key, std::string&, const char*) { add(key); }
   template <class P>
   void section(const char* key, P& sub, const char*) {
-    const std::size_t size = prefix_.size();
-    prefix_ += key;
-    prefix_ += '.';
-    sub.visit(*this);
-    prefix_.resize(size);
+    descend(*this, key, sub);
   }
 
  private:
   void add(const char* key) { paths.push_back(prefix_ + key); }
-  std::string prefix_;
 };
 
 template <class P>
@@ -202,7 +213,7 @@ std::vector<std::string> field_paths(const P& p) {
 // every field of p (and of the structs nested in it) as "path=value" lines,
 // numbers exactly (number(): the shortest text that reads back the same):
 // two structs with the same text hold the same values (a cache key)
-class Fingerprinter {
+class Fingerprinter : SectionPath {
  public:
   std::string text;
 
@@ -231,16 +242,11 @@ class Fingerprinter {
   void operator()(const char* key, std::string& s, const char*) { add(key, std::to_string(s.size()) + ":" + s); }
   template <class P>
   void section(const char* key, P& sub, const char*) {
-    const std::size_t size = prefix_.size();
-    prefix_ += key;
-    prefix_ += '.';
-    sub.visit(*this);
-    prefix_.resize(size);
+    descend(*this, key, sub);
   }
 
  private:
   void add(const char* key, const std::string& value) { text += prefix_ + key + "=" + value + "\n"; }
-  std::string prefix_;
 };
 
 template <class P>
