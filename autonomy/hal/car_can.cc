@@ -72,6 +72,13 @@ constexpr MessageNeed kCar[] = {
        {"RL", "rad/s", -300.0, 300.0, 0.05},
        {"RR", "rad/s", -300.0, 300.0, 0.05}}}},
     {"SteeringAngle", {{{"Angle", "rad", -0.6, 0.6, 1e-3}}}},
+    // the EBS's tank holds up to ~10 bar, a brake line over 100 bar
+    {"VCU_Status",
+     {{{"Asms", "", 0.0, 1.0, 1.0, true},
+       {"Mission", "", 0.0, static_cast<double>(MissionCode::Manual), 1.0, true},
+       {"EbsPressure", "bar", 0.0, 20.0, 0.1},
+       {"BrakePressureFront", "bar", 0.0, 200.0, 0.1},
+       {"BrakePressureRear", "bar", 0.0, 200.0, 0.1}}}},
 };
 
 // a little-endian u32
@@ -172,6 +179,12 @@ CanFrame CarCan::encode(const ResSignal& m) {
   return frame(kRes, m.stamp, {m.go ? 1.0 : 0.0, m.emergency ? 1.0 : 0.0});
 }
 
+CanFrame CarCan::encode(const VcuStatus& m) {
+  return frame(kVcuStatus, m.stamp,
+               {m.asms_on ? 1.0 : 0.0, static_cast<double>(static_cast<int>(m.mission)), m.ebs_pressure,
+                m.brake_pressure_front, m.brake_pressure_rear});
+}
+
 CanFrame CarCan::encode(const ActuatorCommand& m) {
   // a command that is no number fails safe: no drive, full brake (a NaN
   // brake sent as raw 0 would release it); still counted as non-finite
@@ -227,6 +240,18 @@ void CarCan::push(const CanFrame& f) {
       sensors_.push_back(SteeringAngle{f.stamp, v(0)});
       ++counters_.steering;
       break;
+    case kVcuStatus: {
+      // Mission's raw value is the enum's (factor 1, offset 0)
+      const double mission = v(1);
+      if (mission < 0.0 || mission > static_cast<double>(MissionCode::Manual)) {
+        ++counters_.bad_value;
+        return;
+      }
+      sensors_.push_back(VcuStatus{f.stamp, v(0) != 0.0, static_cast<MissionCode>(static_cast<int>(mission)), v(2),
+                                   v(3), v(4)});
+      ++counters_.vcu_status;
+      break;
+    }
   }
 }
 

@@ -1,6 +1,6 @@
 #pragma once
 // the car's CAN bus (scenarios/sensors/paddock.dbc): the VCU sends the stack
-// the IMU, wheel speeds, steering angle and RES frames, the stack (ACU) sends
+// the IMU, wheel speeds, steering angle, RES and VCU status frames, the stack (ACU) sends
 // the VCU its actuator command. CarCan turns HAL messages into those frames and
 // frames back into HAL messages, with the layout the parsed DBC gives; the
 // SocketCAN functions put a frame into and out of Linux's struct can_frame.
@@ -47,12 +47,13 @@ struct CarCanCounters {
   std::uint64_t frames = 0;
   std::uint64_t unknown_id = 0;            // an id (or frame format) the car does not send
   std::uint64_t bad_dlc = 0;               // a dlc other than the DBC's
-  std::uint64_t bad_value = 0;             // an AsState outside the enum
+  std::uint64_t bad_value = 0;             // an AsState or Mission outside its enum
   // an IMU frame whose other half never came (the next IMU frame has another
   // counter, or is a repeat of its own half, which replaces it)
   std::uint64_t unmatched_imu_halves = 0;
   // messages decoded
   std::uint64_t res = 0;
+  std::uint64_t vcu_status = 0;
   std::uint64_t imu = 0;
   std::uint64_t wheel_speeds = 0;
   std::uint64_t steering = 0;
@@ -81,6 +82,7 @@ class CarCan {
   CanFrame encode(const WheelSpeeds& m);
   CanFrame encode(const SteeringAngle& m);
   CanFrame encode(const ResSignal& m);
+  CanFrame encode(const VcuStatus& m);
   CanFrame encode(const ActuatorCommand& m);
 
   // decodes a received frame; a frame that is not the car's, or malformed, is
@@ -99,7 +101,7 @@ class CarCan {
 
  private:
   // the car's messages
-  enum Kind : std::size_t { kRes, kCommand, kImuAccel, kImuRate, kWheels, kSteering, kKinds };
+  enum Kind : std::size_t { kRes, kCommand, kImuAccel, kImuRate, kWheels, kSteering, kVcuStatus, kKinds };
   struct Message {
     std::uint32_t id = 0;
     bool extended = false;

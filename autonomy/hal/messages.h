@@ -39,6 +39,33 @@ struct ResSignal {
   bool emergency = false;
 };
 
+// the missions of the car's mission selector (the FS rules' autonomous
+// missions and the others a driverless car offers), as the VCU reports the
+// one selected: the DBC's value table of VCU_Status.Mission
+enum class MissionCode : std::uint8_t {
+  None = 0,
+  Acceleration = 1,
+  Skidpad = 2,
+  Autocross = 3,
+  Trackdrive = 4,
+  EbsTest = 5,
+  Inspection = 6,
+  Manual = 7,
+};
+
+// what the vehicle control unit reports of the car's safety chain, as the
+// rules' AS state machine needs it: the autonomous system master switch, the
+// mission on the selector, the pressure stored for the emergency brake
+// system (EBS) and the brake lines' pressures
+struct VcuStatus {
+  TimeNs stamp = 0;
+  bool asms_on = false;               // the ASMS is switched on
+  MissionCode mission = MissionCode::None;
+  double ebs_pressure = 0.0;          // bar, the EBS's energy storage (its pneumatic tank)
+  double brake_pressure_front = 0.0;  // bar, the front brake line
+  double brake_pressure_rear = 0.0;   // bar, the rear brake line
+};
+
 // a cone seen by perception, in the vehicle base frame at the measurement time
 struct DetectedCone {
   Vec2 position;                        // base frame (m)
@@ -141,7 +168,7 @@ struct CameraDetections {
 };
 
 using SensorMessage = std::variant<StateEstimate, ResSignal, ConeDetections, Imu, WheelSpeeds, SteeringAngle,
-                                   LidarScan, CameraFrame, CameraDetections>;
+                                   LidarScan, CameraFrame, CameraDetections, VcuStatus>;
 
 // the stack's command to the car's low-level controllers
 struct ActuatorCommand {
@@ -154,5 +181,6 @@ struct ActuatorCommand {
 };
 
 const char* to_string(AsState s);
+const char* to_string(MissionCode m);
 
 }  // namespace paddock::hal

@@ -61,7 +61,9 @@ const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
   const CameraInput* cam = nullptr;
   if (params_.use_camera) {
     const CameraCalibration& calib = params_.camera;
-    if (!camera_) {
+    if (camera_distrusted_) {
+      last_.camera_note = "camera distrusted (lost or frozen)";
+    } else if (!camera_) {
       last_.camera_note = "no camera detections";
     } else if (camera_->detections.stamp < scan.stamp - tol || camera_->detections.stamp > scan.end + tol) {
       last_.camera_note = "no camera detections of this rotation";

@@ -95,6 +95,10 @@ class Perception {
   // detections (or, when it fails, the reason); without one the frame is not looked at
   void add(const hal::CameraFrame& frame);
 
+  // the stack distrusts the camera (lost or frozen): its boxes are not fused
+  // until this is cleared (lidar_camera scans fall back to LiDAR only)
+  void set_camera_distrusted(bool d) { camera_distrusted_ = d; }
+
   // one rotation -> the cones, base frame at the scan's reference time (its end)
   const hal::ConeDetections& process(const hal::LidarScan& scan);
 
@@ -115,6 +119,7 @@ class Perception {
   LidarPipeline pipeline_;
   std::unique_ptr<ConeDetector> detector_;
   std::optional<CameraInput> camera_;
+  bool camera_distrusted_ = false;
   PerceptionFrame last_;
   PerceptionStats stats_;
 };

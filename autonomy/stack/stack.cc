@@ -40,7 +40,10 @@ Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<percep
       spec_(std::move(spec)),
       controller_(params.control, params.vehicle),
       cone_map_(params.cone_map),
-      gates_(spec_.gates) {
+      gates_(spec_.gates),
+      as_(params.as),
+      health_(params.health, params.autonomy.perception != PerceptionMode::GroundTruth,
+              params.autonomy.perception == PerceptionMode::LidarCamera, params.autonomy.slam != SlamMode::GroundTruth) {
   if (params_.autonomy.perception != PerceptionMode::GroundTruth) {
     perception::PerceptionParams pp = params_.perception;
     pp.use_camera = params_.autonomy.perception == PerceptionMode::LidarCamera;
@@ -71,6 +74,7 @@ void Stack::on_message(hal::SensorMessage&& m) {
   // the odometry sensors feed the localisation (slam != ground_truth) and the
   // LiDAR's motion correction (perception = lidar | lidar_camera)
   if (const auto* imu = std::get_if<hal::Imu>(&m)) {
+    health_.imu(now_);
     if (localisation_) {
       if (const std::optional<hal::StateEstimate> e = localisation_->on_imu(*imu)) take_estimate(*e);
     }
@@ -78,6 +82,7 @@ void Stack::on_message(hal::SensorMessage&& m) {
     return;
   }
   if (const auto* wheels = std::get_if<hal::WheelSpeeds>(&m)) {
+    health_.wheels(now_);
     if (localisation_) localisation_->on_wheel_speeds(*wheels);
     if (perception_) perception_->add(*wheels);
     return;
@@ -94,14 +99,18 @@ void Stack::on_message(hal::SensorMessage&& m) {
   } else if (const auto* res = std::get_if<hal::ResSignal>(&m)) {
     go_ = go_ || res->go;
     emergency_ = emergency_ || res->emergency;
+  } else if (const auto* vcu = std::get_if<hal::VcuStatus>(&m)) {
+    vcu_ = *vcu;
   } else if (!perception_) {
     // perception = ground_truth: the raw sensors' messages are not used
   } else if (const auto* scan = std::get_if<hal::LidarScan>(&m)) {
     // slam = lio: the scan localises the car first, its cones are then
     // placed at the pose it gave
+    health_.lidar_scan(now_, scan->points.size());
     if (localisation_) localisation_->on_scan(*scan);
     on_detections(perception_->process(*scan));
   } else if (auto* boxes = std::get_if<hal::CameraDetections>(&m)) {
+    health_.camera(now_, *boxes, state_ ? std::hypot(state_->vx, state_->vy) : 0.0);
     perception_->add(std::move(*boxes));
   } else if (const auto* frame = std::get_if<hal::CameraFrame>(&m)) {
     perception_->add(*frame);
@@ -389,12 +398,57 @@ hal::ActuatorCommand Stack::safe_stop(TimeNs now, const std::string& reason) {
 }
 
 void Stack::emergency(const std::string& reason) {
-  emergency_ = true;
+  if (fault_.empty()) fault_ = reason;
   telemetry_.last_fault = reason;
 }
 
+hal::MissionCode mission_code(Mission m) {
+  switch (m) {
+    case Mission::Acceleration: return hal::MissionCode::Acceleration;
+    case Mission::Skidpad: return hal::MissionCode::Skidpad;
+    case Mission::Autocross: return hal::MissionCode::Autocross;
+    case Mission::Trackdrive: return hal::MissionCode::Trackdrive;
+  }
+  return hal::MissionCode::None;
+}
+
+AsInputs Stack::as_inputs(bool mission_done) {
+  AsInputs in;
+  if (vcu_) {
+    in.vcu_known = true;
+    in.asms_on = vcu_->asms_on;
+    in.mission_selected = vcu_->mission == mission_code(spec_.mission);
+    in.ebs_pressure = vcu_->ebs_pressure;
+    in.brake_pressure = std::min(vcu_->brake_pressure_front, vcu_->brake_pressure_rear);
+  }
+  in.stack_ready = state_.has_value() && !trajectory_.empty();
+  in.res_emergency = emergency_;
+  in.fault = fault_;
+  in.mission_done = mission_done;
+  return in;
+}
+
+double Stack::emergency_steering(TimeNs now, double dt) {
+  if (!state_ || trajectory_.empty() || now - state_->stamp > from_seconds(params_.mission.state_timeout)) return 0.0;
+  control::ControlInput in;
+  in.dt = dt;
+  in.base_pose = state_->pose;
+  in.vx = state_->vx;
+  in.vy = state_->vy;
+  in.yaw_rate = state_->yaw_rate;
+  in.trajectory = &trajectory_;
+  in.max_speed = 0.0;
+  const control::ControlOutput out = controller_.update(in);
+  return out.status == control::Status::Ok ? out.steering_angle : 0.0;
+}
+
 void Stack::tick(TimeNs now, hal::Hal& hal) {
+  now_ = now;
   while (auto m = hal.receive()) on_message(std::move(*m));
+  // the watchdogs and the degraded modes (health.h); a fault it cannot drive with ends in AS Emergency
+  health_.cycle(now, state_ ? std::hypot(state_->vx, state_->vy) : 0.0);
+  if (!health_.fault().empty() && fault_.empty()) emergency(health_.fault());
+  if (perception_) perception_->set_camera_distrusted(health_.camera_distrusted());
   // frames that came before the state estimate of their instant
   while (!waiting_.empty() && !history_.empty() && waiting_.front().stamp <= history_.back().stamp) {
     add_to_map(waiting_.front());
@@ -411,18 +465,21 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   // planner = delaunay: plan whenever the map has news (also before the go, so the car is ready)
   if (params_.autonomy.planner == PlannerMode::Delaunay && state_ && map_news_) plan(*state_);
 
-  // the AS state machine: off -> ready (plan and state known) -> driving (go)
-  // -> finished (stopped after the mission); emergency from any state
+  // the AS state machine (as_machine.h); the mission's end is looked at
+  // below, once this cycle's control has run
+  AsInputs as_in = as_inputs(false);
+  as_in.go = go_;
+  go_ = false;
   auto& as = telemetry_.as_state;
-  if (emergency_) as = hal::AsState::Emergency;
-  if (as == hal::AsState::Off && state_ && !trajectory_.empty()) as = hal::AsState::Ready;
-  if (as == hal::AsState::Ready && go_) as = hal::AsState::Driving;
+  as = as_.update(now, as_in);
 
   hal::ActuatorCommand cmd;
   cmd.stamp = now;
   cmd.as_state = as;
   if (as != hal::AsState::Driving) {
-    // not driving: wheels straight, brakes on
+    // not driving: brakes on; wheels straight, or in AS Emergency along the
+    // trajectory while the EBS brakes
+    if (as == hal::AsState::Emergency && params_.as.steer_in_emergency) cmd.steering_angle = emergency_steering(now, dt);
     hal.send(cmd);
     return;
   }
@@ -467,6 +524,8 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   } else {
     max_speed = finish_approach_cap(st.pose.position());
   }
+  // degraded (the LiDAR lost or sparse): on the map and the odometry, slower
+  max_speed = std::min(max_speed, health_.speed_cap(now));
 
   control::ControlInput in;
   in.dt = dt;
@@ -491,7 +550,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   if (spec_.finish_crossings == 0 && !trajectory_.closed && out.diagnostics.s >= trajectory_.length - end_margin) {
     start_stopping(now, st.vx);
   }
-  if (telemetry_.stopping && speed < mp.standstill_speed) as = hal::AsState::Finished;
+  if (telemetry_.stopping && speed < mp.standstill_speed) as = as_.update(now, as_inputs(true));
 
   cmd.as_state = as;
   if (as == hal::AsState::Finished) {

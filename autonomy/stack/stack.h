@@ -18,7 +18,9 @@
 #include "autonomy/planning/path_planner.h"
 #include "autonomy/planning/skidpad.h"
 #include "autonomy/slam/cone_map.h"
+#include "autonomy/stack/as_machine.h"
 #include "autonomy/stack/gates.h"
+#include "autonomy/stack/health.h"
 #include "autonomy/stack/localisation.h"
 
 namespace paddock::stack {
@@ -136,6 +138,8 @@ struct StackParams {
   slam::ConeMapParams cone_map;
   GateParams gates;
   SlamParams slam;
+  AsParams as;
+  HealthParams health;
 
   template <class V>
   void visit(V& v) {
@@ -148,6 +152,8 @@ struct StackParams {
     v.section(PADDOCK_PARAM(cone_map), "the stack's map of cones");
     v.section(PADDOCK_PARAM(gates), "timekeeping gates from the big orange cones");
     v.section(PADDOCK_PARAM(slam), "the stack's own state estimation (slam != ground_truth)");
+    v.section(PADDOCK_PARAM(as), "the rules' autonomous system state machine");
+    v.section(PADDOCK_PARAM(health), "the stack's watch over its inputs and cycle, and its degraded modes");
   }
   std::string check() const {
     const std::string why = params::validate(vehicle);
@@ -199,12 +205,17 @@ class Stack {
   // drains the HAL's messages, plans when there is news, runs one control
   // cycle, sends one command
   void tick(TimeNs now, hal::Hal& hal);
-  // AS Emergency from the next cycle on, latched as the RES's emergency is
-  // (the car binary's watchdogs: a sensor went silent); `reason` becomes the
+  // a fault the stack cannot drive with (the car binary's watchdogs: a
+  // sensor went silent): AS Emergency from the next cycle on (from Ready or
+  // Driving; AS Off stays Off, waiting for it), latched; `reason` becomes the
   // last fault
   void emergency(const std::string& reason);
 
   const Telemetry& telemetry() const { return telemetry_; }
+  // the AS state machine: its state, transitions and what it waits for
+  const AsMachine& as_machine() const { return as_; }
+  // what the stack noticed of its inputs and cycle, and its degraded modes
+  const Health& health() const { return health_; }
   const Trajectory& trajectory() const { return trajectory_; }
   const slam::ConeMap& cone_map() const { return cone_map_; }
   // slam != ground_truth: the stack's own localisation, else null
@@ -251,6 +262,11 @@ class Stack {
   bool gate_still_seen(const Segment& g) const;
   void start_stopping(TimeNs now, double speed);
   hal::ActuatorCommand safe_stop(TimeNs now, const std::string& reason);
+  // what the machine sees this cycle
+  AsInputs as_inputs(bool mission_done);
+  // AS Emergency: the steering along the trajectory while the EBS brakes
+  // (0 when there is no fresh estimate or trajectory)
+  double emergency_steering(TimeNs now, double dt);
 
   StackParams params_;
   MissionSpec spec_;
@@ -283,14 +299,21 @@ class Stack {
   // crossed it (its cones beside the car at the start, out of the sensors'
   // view) still counts
   std::vector<std::pair<Vec2, double>> path_marks_;
-  bool go_ = false;
-  bool emergency_ = false;
+  AsMachine as_;
+  Health health_;
+  TimeNs now_ = 0;                     // the cycle draining the messages
+  std::optional<hal::VcuStatus> vcu_;  // the VCU's last status
+  bool go_ = false;                    // a go came since the last cycle
+  bool emergency_ = false;             // the RES's emergency stop, latched
+  std::string fault_;                  // a fault the stack cannot drive with, latched
   std::optional<TimeNs> last_tick_;
   TimeNs stop_start_ = 0;
   double stop_speed_ = 0.0;
 };
 
 const char* to_string(Mission m);
+// what the car's mission selector shows for a mission
+hal::MissionCode mission_code(Mission m);
 // the scenario's names: ground_truth, lidar, lidar_camera
 const char* to_string(PerceptionMode m);
 const char* to_string(SlamMode m);

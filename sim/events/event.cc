@@ -110,8 +110,22 @@ void Event::on_sample(const CarSample& s) {
   result_.doo = s.doo_total;
   energy_ = s.energy;
 
-  if (s.as_emergency) return finish_run(false, "the car went to AS Emergency", s.t);
-  if (!go_time_) return;
+  const bool at_rest = s.speed < params_.standstill_speed;
+  if (s.as_emergency && !emergency_since_) emergency_since_ = s.t;
+  if (emergency_since_) {
+    // the EBS brakes the car to rest: the run ends there (a DNF), the cones
+    // it hits on the way still count
+    if (at_rest) return finish_run(false, "the car went to AS Emergency", s.t);
+    if (s.t - *emergency_since_ > params_.stop_time) {
+      return finish_run(false, "the car went to AS Emergency and was not at rest within " + seconds(params_.stop_time), s.t);
+    }
+  }
+  if (!go_time_) {
+    if (s.t > params_.ready_timeout) {
+      return finish_run(false, "no go: the car did not hold AS Ready long enough within " + seconds(params_.ready_timeout), s.t);
+    }
+    return;
+  }
 
   // off course: all four wheels outside the boundaries; one excursion counts once
   bool all_off = true;
@@ -129,10 +143,10 @@ void Event::on_sample(const CarSample& s) {
     return finish_run(false, "left the track for good (all wheels off for longer than " +
                                  seconds(params_.off_track_dnf_time) + ")", s.t);
   }
-  const bool at_rest = s.speed < params_.standstill_speed;
   if (!at_rest) at_rest_since_.reset();
   else if (!at_rest_since_) at_rest_since_ = s.t;
 
+  if (emergency_since_) return;
   if (crossed_finish_) {
     // after the finish: at rest and AS Finished, inside the stop zone
     if (at_rest && s.as_finished) {

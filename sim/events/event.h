@@ -34,6 +34,7 @@ struct EventParams {
   double off_track_dnf_time = 5.0;
   double stall_time = 10.0;
   double standstill_speed = 0.05;
+  double ready_timeout = 60.0;
 
   template <class V>
   void visit(V& v) {
@@ -42,6 +43,7 @@ struct EventParams {
     v(PADDOCK_PARAM(off_track_dnf_time), {"s", params::in(0.01, 600.0), "time with all four wheels off the track that ends the run (DNF)"});
     v(PADDOCK_PARAM(stall_time), {"s", params::in(0.1, 600.0), "time at rest on track before the finish that ends the run (DNF)"});
     v(PADDOCK_PARAM(standstill_speed), {"m/s", params::in(0.0, 5.0), "slower counts as at rest"});
+    v(PADDOCK_PARAM(ready_timeout), {"s", params::in(1.0, 86400.0), "sim time without the go (the car never held AS Ready long enough) before a DNF"});
   }
 };
 
@@ -112,6 +114,7 @@ class Event {
   const world::TrackModel* track_;  // for the on-track test
 
   std::optional<double> go_time_;
+  std::optional<double> emergency_since_;  // the car reported AS Emergency: the EBS brakes it to rest
   bool lap_running_ = false;
   double lap_start_ = 0.0;
   double energy_ = 0.0;             // the car's energy counter at the last sample (J)

@@ -69,6 +69,7 @@ SimModel compile_model(const Scenario& scenario, const world::TrackModel& track)
   m.every.imu = steps_per(scenario.imu.rate);
   m.every.wheel_speeds = steps_per(scenario.wheel_speeds.rate);
   m.every.steering = steps_per(scenario.steering_sensor.rate);
+  m.every.vcu_status = sim.physics_rate / scenario.vcu.status_rate;
   m.go = from_seconds(scenario.scenario.go_time);
   m.pose_history_span = std::max(kNsPerSecond, 2 * from_seconds(1.0 / scenario.lidar.rate));
   return m;

@@ -26,6 +26,7 @@ struct StepPeriods {
   long imu = 1;
   long wheel_speeds = 1;
   long steering = 1;
+  long vcu_status = 1;
 };
 
 struct SimModel {
@@ -47,7 +48,7 @@ struct SimModel {
   double dt = 0.001;           // s, one physics step
   TimeNs dt_ns = 1000000;
   StepPeriods every;
-  TimeNs go = 0;               // when the go signal is given
+  TimeNs go = 0;               // the go signal comes this long after the car shows AS Ready
   TimeNs pose_history_span = 0;  // the true poses kept: a second, and two LiDAR rotations at least
 };
 

@@ -75,18 +75,33 @@ void RawSensors::update_scene(const world::ConeWorld& cones) {
 }
 
 const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,
-                                                  SimHal& hal) {
+                                                  SimHal& hal, const FaultInjector& faults, double t) {
   update_scene(cones);
   const TimeNs start = now - lidar_.period_ns();
-  if (camera_) {
+  if (camera_ && !faults.camera_dead(t)) {
     const TimeNs exposure = sensors::trigger_time(lidar_.params(), camera_->params().trigger_azimuth, start);
-    camera_->render(*world_, poses.at(exposure), exposure, frame_, annotation_);
-    // the detector node's boxes on it, as the car's posts them (a frame it
-    // cannot read gives none, as a node that fails posts nothing)
-    sensors::AnnotationDetection d = detector_->detect(frame_, annotation_);
-    if (d.ok) hal.post(std::move(d.detections));
+    if (frozen_ && faults.camera_frozen(t)) {
+      // the same image again, stamped anew: the node finds the same boxes on it
+      hal::CameraDetections again = *frozen_;
+      again.stamp = exposure;
+      hal.post(std::move(again));
+    } else {
+      camera_->render(*world_, poses.at(exposure), exposure, frame_, annotation_);
+      // the detector node's boxes on it, as the car's posts them (a frame it
+      // cannot read gives none, as a node that fails posts nothing)
+      sensors::AnnotationDetection d = detector_->detect(frame_, annotation_);
+      if (d.ok) {
+        frozen_ = d.detections;
+        hal.post(std::move(d.detections));
+      }
+    }
   }
-  const std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [&poses](TimeNs t) { return poses.at(t); }, start);
+  if (!faults.lidar_sends(t)) {
+    truth_.clear();
+    return truth_;
+  }
+  std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [&poses](TimeNs at) { return poses.at(at); }, start);
+  faults.filter_lidar(t, raw);
   truth_.resize(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) truth_[i] = raw[i].cone;
   if (const WireLink* wire = hal.wire(); wire != nullptr && wire->has_lidar()) {

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "autonomy/hal/messages.h"
+#include "sim/runner/faults.h"
 #include "sim/runner/sim_hal.h"
 #include "sim/sensors/annotation_detector.h"
 #include "sim/sensors/camera.h"
@@ -64,8 +65,10 @@ class RawSensors {
   // returns its ground truth: per point the cone index hit (sensors::kHitGround
   // the ground, kHitStructure a barrier block), in
   // the order of the scan's points
+  // faults: the LiDAR's and the camera's at t (s, now): a rotation not sent,
+  // returns lost, a dead or frozen camera
   const std::vector<std::int32_t>& emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,
-                                        SimHal& hal);
+                                        SimHal& hal, const FaultInjector& faults, double t);
   // the stamp of the scan's last column (the scan's `end`) for a rotation ending at `now`
   TimeNs scan_end(TimeNs now) const;
   // the last camera frame rendered (for the perception figures), or null
@@ -78,6 +81,7 @@ class RawSensors {
   std::unique_ptr<sensors::Camera> camera_;
   std::unique_ptr<sensors::AnnotationDetector> detector_;
   hal::CameraFrame frame_;
+  std::optional<hal::CameraDetections> frozen_;  // a frozen camera's last detections
   sensors::CameraAnnotation annotation_;
   sensors::GroundParams ground_;
   std::vector<world::Block> blocks_;

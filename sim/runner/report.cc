@@ -63,6 +63,36 @@ std::vector<std::string> check_expectations(const Expectations& e, const RunResu
                        (ev.laps.empty() ? std::string("no lap") : fixed(100.0 * (best / *r.limit_lap - 1.0), 1) + " %"));
     }
   }
+  // the car's own report (the last log row's AS state), the VCU's for a stack in the car binary
+  const bool emergency = (!r.log.empty() && r.log.back().as_state == static_cast<int>(hal::AsState::Emergency)) ||
+                         (r.ebs.fired && r.ebs.cause.find("AS Emergency") != std::string::npos);
+  if (e.emergency && *e.emergency != emergency) {
+    failed.push_back(std::string("emergency: expected ") + (*e.emergency ? "AS Emergency" : "no AS Emergency") + ", got " +
+                     (emergency ? "AS Emergency" : "none") + (r.ebs.fired ? " (EBS: " + r.ebs.cause + ")" : ""));
+  }
+  if (e.ebs_within_rules) {
+    const bool within = r.ebs.fired && r.ebs.stopped_at && r.ebs.distance <= ebs_rules_distance(r.ebs.speed);
+    if (*e.ebs_within_rules != within) {
+      failed.push_back(std::string("EBS within the rules: expected ") + (*e.ebs_within_rules ? "yes" : "no") + ", got " +
+                       (r.ebs.fired ? ebs_line(r.ebs) : std::string("the EBS never fired")));
+    }
+  }
+  if (e.notice_max) {
+    for (const FaultNote& f : r.faults) {
+      const std::optional<FaultResponse> n = fault_response(r, f);
+      if (!n) {
+        failed.push_back("notice: " + f.name + " at " + fixed(f.at, 3) + " s was never noticed");
+      } else if (n->delay > *e.notice_max) {
+        failed.push_back("notice: " + f.name + ": expected within " + fixed(*e.notice_max, 3) + " s, got " + fixed(n->delay, 3) + " s");
+      }
+    }
+  }
+  if (e.doo_after_fault_max && !r.faults.empty()) {
+    int after = 0;
+    for (const ConeHit& h : r.cones_hit) after += h.t >= r.faults.front().at ? 1 : 0;
+    if (after > *e.doo_after_fault_max)
+      failed.push_back("doo after the fault: expected at most " + std::to_string(*e.doo_after_fault_max) + ", got " + std::to_string(after));
+  }
   if (!r.stack_remote && e.fallbacks_max && r.fallbacks > *e.fallbacks_max) {
     failed.push_back("fallbacks: expected at most " + std::to_string(*e.fallbacks_max) + ", got " + std::to_string(r.fallbacks));
   }
@@ -77,6 +107,27 @@ std::vector<std::string> check_expectations(const Expectations& e, const RunResu
       if (set) failed.push_back(std::string(what) + ": not measured: the stack ran in the car binary (transport = udp)");
   }
   return failed;
+}
+
+std::optional<FaultResponse> fault_response(const RunResult& r, const FaultNote& f) {
+  std::optional<FaultResponse> best;
+  const auto consider = [&](double t, const std::string& what) {
+    if (t + 1e-9 >= f.at && (!best || t < best->t)) best = FaultResponse{t, t - f.at, what};
+  };
+  for (const stack::HealthEvent& e : r.health) consider(to_seconds(e.t), "the stack: " + e.what);
+  for (const stack::AsTransition& a : r.as_transitions)
+    if (a.to == hal::AsState::Emergency) consider(to_seconds(a.t), std::string("the stack: AS Emergency (") + a.reason + ")");
+  if (r.ebs.fired) consider(r.ebs.t, "the VCU: EBS fired (" + r.ebs.cause + ")");
+  return best;
+}
+
+std::string ebs_line(const EbsStop& e) {
+  std::string l = "fired at " + fixed(e.t, 3) + " s (" + e.cause + ") at " + fixed(e.speed, 2) + " m/s: ";
+  if (!e.stopped_at) return l + "still rolling when the run ended, after " + fixed(e.distance, 2) + " m";
+  const double allowed = ebs_rules_distance(e.speed);
+  return l + "at rest after " + fixed(e.distance, 2) + " m and " + fixed(*e.stopped_at - e.t, 2) + " s (mean " +
+         fixed(e.mean_decel(), 1) + " m/s^2); the rules allow " + fixed(allowed, 2) +
+         " m from that speed (T 15.3 / IN 6.3: 0.2 s, then 8 m/s^2): " + (e.distance <= allowed ? "within" : "EXCEEDED");
 }
 
 std::string summary_text(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed) {
@@ -169,6 +220,21 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
   }
   if (!r.stack_remote)
     o << "  stack       " << r.fallbacks << " fallback cycles" << (r.fault.empty() ? "" : ", last fault: " + r.fault) << "\n";
+  for (std::size_t i = 0; i < r.faults.size(); ++i) {
+    const FaultNote& f = r.faults[i];
+    o << (i == 0 ? "  faults      " : "              ") << f.name << " at " << fixed(f.at, 3) << " s: " << f.what << "\n";
+    const std::optional<FaultResponse> n = fault_response(r, f);
+    o << "                " << (n ? "noticed after " + fixed(n->delay, 3) + " s by " + n->what : std::string("not noticed")) << "\n";
+  }
+  for (std::size_t i = 0; i < r.health.size(); ++i) {
+    o << (i == 0 ? "  health      " : "              ") << fixed(to_seconds(r.health[i].t), 3) << " s: " << r.health[i].what << "\n";
+  }
+  for (std::size_t i = 0; i < r.as_transitions.size(); ++i) {
+    const stack::AsTransition& a = r.as_transitions[i];
+    o << (i == 0 ? "  AS          " : "              ") << hal::to_string(a.from) << " -> " << hal::to_string(a.to)
+      << " at " << fixed(to_seconds(a.t), 3) << " s: " << a.reason << "\n";
+  }
+  if (r.ebs.fired) o << "  EBS         " << ebs_line(r.ebs) << "\n";
   o << "  speed       " << fixed(r.sim_time, 1) << " s simulated in " << fixed(r.wall_time, 3) << " s ("
     << fixed(r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0, 0) << "x real time)\n";
   if (!failed.empty()) {
@@ -250,6 +316,31 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
                            {"bins", bins},
                            {"all", bin_json(r.perception.total())}};
   const double penalty_s = rules.doo_penalty * ev.doo + rules.oc_penalty * ev.oc + rules.uss_penalty * ev.uss;
+  Json as_transitions = Json::array();
+  for (const stack::AsTransition& a : r.as_transitions)
+    as_transitions.push_back({{"t", to_seconds(a.t)}, {"from", hal::to_string(a.from)}, {"to", hal::to_string(a.to)}, {"reason", a.reason}});
+  Json faults = Json::array();
+  for (const FaultNote& f : r.faults) {
+    const std::optional<FaultResponse> n = fault_response(r, f);
+    faults.push_back({{"name", f.name},
+                      {"what", f.what},
+                      {"at", f.at},
+                      {"noticed_after", n ? Json(n->delay) : Json(nullptr)},
+                      {"response", n ? Json(n->what) : Json(nullptr)}});
+  }
+  Json health = Json::array();
+  for (const stack::HealthEvent& h : r.health) health.push_back({{"t", to_seconds(h.t)}, {"what", h.what}});
+  Json ebs = nullptr;
+  if (r.ebs.fired) {
+    ebs = {{"t", r.ebs.t},
+           {"cause", r.ebs.cause},
+           {"speed", r.ebs.speed},
+           {"distance", r.ebs.distance},
+           {"stop_time", r.ebs.stopped_at ? Json(*r.ebs.stopped_at - r.ebs.t) : Json(nullptr)},
+           {"mean_decel", r.ebs.stopped_at ? Json(r.ebs.mean_decel()) : Json(nullptr)},
+           {"rules_distance", ebs_rules_distance(r.ebs.speed)},
+           {"within_rules", r.ebs.stopped_at.has_value() && r.ebs.distance <= ebs_rules_distance(r.ebs.speed)}};
+  }
   // JSON has no NaN or infinity: nlohmann writes them as null
   const Json j = {
       {"scenario", s.name},
@@ -271,6 +362,10 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"slam", r.stack_remote ? Json(nullptr) : Json(slam_json(s, r.slam))},
       {"perception", r.stack_remote ? Json(nullptr) : perception},
       {"stack", r.stack_remote ? Json("car binary") : Json{{"fallbacks", r.fallbacks}, {"fault", r.fault}}},
+      {"as_transitions", as_transitions},
+      {"faults", faults},
+      {"health", health},
+      {"ebs", ebs},
       {"expectations_failed", failed},
   };
   return j.dump() + "\n";

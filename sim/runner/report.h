@@ -1,6 +1,7 @@
 #pragma once
 // what a run leaves behind: the readable summary, summary.json, log.csv, and
 // the check of a scenario's [expect] section.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,18 @@ std::string log_csv(const std::vector<LogRow>& log);
 // slam.csv: the estimate against the truth at every log sample (slam != ground_truth)
 inline constexpr const char* kSlamCsvHeader = "t,x,y,yaw,x_true,y_true,yaw_true,error,sigma";
 std::string slam_csv(const std::vector<SlamSample>& series);
+
+// how the car answered an injected fault: the first thing the stack (a
+// health event, AS Emergency) or the VCU (the EBS) did at or after it
+struct FaultResponse {
+  double t = 0.0;      // s
+  double delay = 0.0;  // s after the fault
+  std::string what;
+};
+std::optional<FaultResponse> fault_response(const RunResult& r, const FaultNote& f);
+
+// the EBS's stop in words, against the rules' distance from its speed
+std::string ebs_line(const EbsStop& e);
 
 // a double as the shortest text that reads back to the same value
 std::string fmt(double v);

@@ -256,11 +256,16 @@ std::string as_section_key(const std::string& problem) {
 }  // namespace
 
 std::string Scenario::check() const {
+  if (scenario.go_time < as.ready_wait)
+    return "scenario.go_time (" + params::number(scenario.go_time) + " s) is shorter than as.ready_wait (" +
+           params::number(as.ready_wait) + " s): the stack would ignore the go";
   if ((autonomy.slam == stack::SlamMode::Lio || autonomy.slam == stack::SlamMode::LioGraph) &&
       autonomy.perception == stack::PerceptionMode::GroundTruth)
     return "autonomy.slam = lio or lio_graph needs the LiDAR's scans: autonomy.perception = lidar or lidar_camera";
   const double limit = vehicle::stable_step_limit(vehicle);
-  if (1.0 / sim.physics_rate <= limit) return "";
+  if (1.0 / sim.physics_rate <= limit) {
+    return sim.physics_rate % vcu.status_rate == 0 ? "" : "sim.physics_rate must be a whole multiple of vcu.status_rate";
+  }
   return "sim.physics_rate must be at least " + std::to_string(static_cast<int>(std::ceil(1.0 / limit))) +
          " Hz for this vehicle (its tyre modes need a step of at most " + params::number(std::floor(limit * 1e4) / 10.0) +
          " ms to integrate stably)";
@@ -321,7 +326,7 @@ std::string resolved_ini(const Scenario& scenario) {
     const std::string v = k.get();
     const std::string comment = k.unit.empty() ? k.doc : k.doc.empty() ? k.unit : k.unit + ", " + k.doc;
     // an unset optional value stays a comment; an empty text is a value
-    if (v.empty() && k.expected != "text") o << "; " << k.name << " =  ; (not checked) " << comment << "\n";
+    if (v.empty() && k.expected != "text") o << "; " << k.name << " =  ; (unset) " << comment << "\n";
     else o << k.name << " = " << v << "  ; " << comment << "\n";
   }
   return o.str();
@@ -344,7 +349,7 @@ std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream) 
   };
   static constexpr Stream kStreams[] = {{"cone_sensor", 1, 0},     {"imu", 2, 0},   {"wheel_speeds", 3, 0},
                                         {"steering_sensor", 4, 0}, {"lidar", 5, 0}, {"camera", 5, 0xC0FFEEULL},
-                                        {"detector", 6, 0},        {"slam", 7, 0}};
+                                        {"detector", 6, 0},        {"slam", 7, 0},  {"faults", 8, 0}};
   for (const Stream& s : kStreams)
     if (s.name == stream) return (scenario_seed * 0x9E3779B97F4A7C15ULL + s.offset) ^ s.scramble;
   assert(false && "unknown random stream");
@@ -374,6 +379,8 @@ stack::StackParams stack_params(const Scenario& s) {
   p.mission = s.mission;
   p.cone_map = s.cone_map;
   p.gates = s.gates;
+  p.as = s.as;
+  p.health = s.health;
   // what the stack knows of its car comes from the same [vehicle] section as
   // the simulated car: one place for each value
   const vehicle::VehicleParams& v = s.vehicle;

@@ -21,11 +21,13 @@
 #include "sim/sensors/imu.h"
 #include "sim/sensors/lidar.h"
 #include "sim/sensors/odometry_sensors.h"
+#include "sim/vehicle/vcu.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
 #include "sim/world/track.h"
 #include "sim/world/venue.h"
 #include "autonomy/common/params.h"
+#include "sim/runner/faults.h"
 #include "sim/runner/ini.h"
 #include "sim/runner/schema.h"
 
@@ -39,6 +41,7 @@ struct ScenarioSection {
   // every random draw of the run derives from it (stream_seed)
   std::uint64_t seed = 1;
   // the rules ask for at least 5 s in AS Ready
+  // the official gives the go once the car has shown AS Ready this long
   double go_time = 5.0;
 
   static constexpr params::Choice<events::EventKind> kEvents[] = {{"trackdrive", events::EventKind::Trackdrive},
@@ -82,7 +85,7 @@ struct HalSection {
   void visit(V& v) {
     v(PADDOCK_PARAM(transport), kTransports, "memory: the messages as structs; wire: through their wire formats and the car's decoders; udp: the wire's bytes to a car binary (paddock car) in lock-step");
     v(PADDOCK_PARAM(lidar_metadata), "the LiDAR's metadata file (Ouster sensor_info JSON): the layout the simulated LiDAR casts and the decoder reads");
-    v(PADDOCK_PARAM(dbc), "the car's CAN database (DBC): the frames of the IMU, wheel speeds, steering, RES and commands");
+    v(PADDOCK_PARAM(dbc), "the car's CAN database (DBC): the frames of the IMU, wheel speeds, steering, RES, VCU status and commands");
   }
 };
 
@@ -123,6 +126,10 @@ struct Expectations {
   std::optional<double> ate_rms_max;
   std::optional<double> map_recall_min;
   std::optional<double> best_above_limit_max;
+  std::optional<bool> emergency;
+  std::optional<bool> ebs_within_rules;
+  std::optional<double> notice_max;
+  std::optional<int> doo_after_fault_max;
 
   template <class V>
   void visit(V& v) {
@@ -141,6 +148,10 @@ struct Expectations {
     v(PADDOCK_PARAM(ate_rms_max), {"m", positive, "the state estimate's RMS position error (ATE) at most"});
     v(PADDOCK_PARAM(map_recall_min), {"", params::fraction(), "the final map's recall (true cones along the path it holds) at least"});
     v(PADDOCK_PARAM(best_above_limit_max), {"", positive, "the best lap's share above the car's limit lap (circuits), at most"});
+    v(PADDOCK_PARAM(emergency), "the car goes to AS Emergency (the EBS brakes it to rest)");
+    v(PADDOCK_PARAM(notice_max), {"s", positive, "each injected fault noticed by the stack (or the VCU) within this"});
+    v(PADDOCK_PARAM(doo_after_fault_max), {"", count, "cones down or out from the first fault on, at most"});
+    v(PADDOCK_PARAM(ebs_within_rules), "the EBS fired and stopped the car within the rules' distance from its speed (0.2 s, then 8 m/s^2)");
   }
 };
 
@@ -162,6 +173,7 @@ struct Scenario {
   car::CarParams car;
   // the car and the world
   vehicle::VehicleParams vehicle;
+  vehicle::VcuParams vcu;
   world::ConeWorldParams cones;
   sensors::GroundParams ground;
   world::VenueParams venue;
@@ -184,7 +196,10 @@ struct Scenario {
   stack::GateParams gates;
   stack::SlamParams slam;
   slam::LioParams lio;
-  // the simulation itself, and what a CI run must achieve
+  stack::AsParams as;
+  stack::HealthParams health;
+  // what goes wrong, the simulation itself, and what a CI run must achieve
+  FaultsSection faults;
   SimSection sim;
   Expectations expect;
 
@@ -195,6 +210,7 @@ struct Scenario {
     v.section(PADDOCK_PARAM(hal), "the HAL between the simulator and the stack: transport and the sensors' wire descriptions");
     v.section(PADDOCK_PARAM(car), "the car binary (paddock car): its sockets, clock and watchdogs; transport = udp sends to it");
     v.section(PADDOCK_PARAM(vehicle), "every physical parameter of the car, all required: include = vehicles/default.ini");
+    v.section(PADDOCK_PARAM(vcu), "the car's vehicle control unit and emergency brake system (EBS): status frame, pressures, EBS delay, ACU watchdog");
     v.section(PADDOCK_PARAM(cones), "the cones' physics (Box2D): masses, knock-over impulses, frictions");
     v.section(PADDOCK_PARAM(ground), "the ground the sensors see (the vehicle model stays planar)");
     v.section(PADDOCK_PARAM(venue), "what stands around the track besides the cones: barrier rows the sensors see");
@@ -215,6 +231,9 @@ struct Scenario {
     v.section(PADDOCK_PARAM(gates), "the timekeeping gates the stack learns from big orange cones");
     v.section(PADDOCK_PARAM(slam), "the stack's own state estimation (slam != ground_truth)");
     v.section(PADDOCK_PARAM(lio), "the LiDAR-inertial odometry (slam = lio)");
+    v.section(PADDOCK_PARAM(as), "the stack's AS state machine of the rules (ready wait, EBS and brake checks)");
+    v.section(PADDOCK_PARAM(health), "the stack's watchdogs and degraded modes (LiDAR lost or sparse, camera lost or frozen, cycle overrun)");
+    v.section(PADDOCK_PARAM(faults), "timed faults injected into the car's sensors, computer, bus and safety chain");
     v.section(PADDOCK_PARAM(sim), "the simulation's rates");
     v.section(PADDOCK_PARAM(expect), "what a CI scenario must achieve (unset entries are not checked)");
   }
@@ -256,7 +275,7 @@ world::TrackFile load_track_file(const std::string& path);
 // the seed of one named random stream of a run: every random draw of a run
 // comes from the scenario's seed through this function. The streams:
 // "cone_sensor", "imu", "wheel_speeds", "steering_sensor", "lidar", "camera",
-// "detector", "slam" (the stack's particle filter); any other name is a
+// "detector", "slam" (the stack's particle filter), "faults" ([faults]); any other name is a
 // programming error. Their numbering is fixed: changing it changes every result.
 std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream);
 

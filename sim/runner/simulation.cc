@@ -42,6 +42,11 @@ double imu_vertical_accel(const SimModel& model, const SimState& s, const Pose2&
   return g.dx * aw.x + g.dy * aw.y + g.dxx * vw.x * vw.x + 2.0 * g.dxy * vw.x * vw.y + g.dyy * vw.y * vw.y;
 }
 
+// a frame the VCU puts on the CAN bus, unless the bus loses it
+void post_can(SimState& s, hal::SensorMessage m) {
+  if (s.faults.can_delivers(s.t)) s.hal.post(std::move(m));
+}
+
 // the odometry sensors due now: the IMU at the base origin's acceleration
 // (from the CG's: a_base = a_cg + alpha x r - omega^2 r with r = (-lr, 0)),
 // the wheel speeds, the steering angle
@@ -53,16 +58,33 @@ void measure_odometry(const SimModel& model, SimState& s, const Pose2& base) {
     const double az = imu_vertical_accel(model, s, base, ax_base, ay_base);
     const sensors::ImuSample m = s.imu.measure(ax_base, ay_base, s.car.r, s.car.yaw_accel, s.now, az);
     s.last_imu = hal::Imu{m.stamp, m.ax, m.ay, m.gz, m.az, m.gx, m.gy};
-    s.hal.post(s.last_imu);
+    s.faults.apply(s.t, s.last_imu, static_cast<double>(model.every.imu) * model.dt);
+    post_can(s, s.last_imu);
   }
   if (s.k % model.every.wheel_speeds == 0) {
     const sensors::WheelSpeedSample m = s.wheel_speeds.measure(vehicle::wheel_speeds(car, s.car), s.now);
-    s.hal.post(hal::WheelSpeeds{m.stamp, m.omega});
+    hal::WheelSpeeds w{m.stamp, m.omega};
+    s.faults.apply(s.t, w);
+    post_can(s, std::move(w));
   }
   if (s.k % model.every.steering == 0) {
     const sensors::SteeringSample m = s.steering.measure(s.car.steering, s.now);
-    s.hal.post(hal::SteeringAngle{m.stamp, m.angle});
+    hal::SteeringAngle a{m.stamp, m.angle};
+    s.faults.apply(s.t, a);
+    post_can(s, std::move(a));
   }
+}
+
+// the VCU's status and the RES's frames; the RES's emergency stop and the
+// EBS's tank as the faults have them
+void vcu_due(const SimModel& model, SimState& s) {
+  if (const std::optional<double> tank = s.faults.ebs_tank(s.t)) s.vcu.set_ebs_tank(*tank);
+  const bool pressed = s.faults.res_pressed(s.t);
+  if (pressed && !s.vcu.ebs_fired()) s.vcu.res_emergency(s.now);
+  if (s.k % model.every.vcu_status != 0) return;
+  post_can(s, s.vcu.status(s.now));
+  // the RES's frame goes on repeating the emergency stop
+  if (pressed) post_can(s, hal::ResSignal{s.now, false, true});
 }
 
 // the control cycle: the delivered frames, the state estimate and the go
@@ -78,7 +100,8 @@ void control(const SimModel& model, SimState& s, const Pose2& base) {
     const Vec2 v = vehicle::base_velocity(model.scenario.vehicle, s.car);
     s.hal.post(hal::StateEstimate{s.now, base, v.x, v.y, s.car.r});
   }
-  if (!s.go_sent && s.now >= model.go) {
+  // the official gives the go once the car has shown AS Ready for go_time
+  if (!s.go_sent && s.ready_since && s.now - *s.ready_since >= model.go) {
     s.hal.post(hal::ResSignal{s.now, true, false});
     s.go_sent = true;
     s.event.start(s.t);
@@ -91,8 +114,9 @@ void control(const SimModel& model, SimState& s, const Pose2& base) {
   }
   if (s.hal.command()) {
     const hal::ActuatorCommand& c = *s.hal.command();
-    s.input = vehicle::DriverInput{c.steering_angle, c.throttle, c.brake, c.yaw_moment};
+    s.vcu.command(s.now, c);
     s.as_state = c.as_state;
+    if (!s.ready_since && c.as_state == hal::AsState::Ready) s.ready_since = s.now;
   }
   ++s.control_cycles;
 }
@@ -122,15 +146,36 @@ void run_due(const SimModel& model, SimState& s) {
   // a LiDAR rotation that ends now, cast from the poses it was taken at
   s.true_poses.record(s.now, base);
   if (s.raw && s.raw->rotation_ends(s.now)) {
-    const std::vector<std::int32_t>& hit = s.raw->emit(s.now, s.cones, s.true_poses, s.hal);
+    const std::vector<std::int32_t>& hit = s.raw->emit(s.now, s.cones, s.true_poses, s.hal, s.faults, s.t);
     s.visible.emplace_back(s.raw->scan_end(s.now), cones_hit(hit, static_cast<std::size_t>(s.cones.cone_count())));
     while (s.visible.size() > 4) s.visible.pop_front();
   }
   measure_odometry(model, s, base);
-  s.controlled = s.k % model.every.control == 0;
+  vcu_due(model, s);
+  // the stack's cycle, unless its computer stalls
+  s.controlled = s.k % model.every.control == 0 && s.faults.control_runs(s.t);
   if (s.controlled) control(model, s, base);
+  // the VCU's watchdog and the EBS, then what the actuators hold until the next step
+  s.input = s.vcu.actuate(s.now);
+  s.faults.apply(s.t, s.input);
   s.sampled = s.k % model.every.log == 0;
   if (s.sampled) sample(model, s, base);
+}
+
+// the EBS's stop: from the instant it fired, the distance to rest
+void measure_ebs_stop(const SimModel& model, SimState& s, double speed) {
+  EbsStop& e = s.ebs;
+  if (!e.fired) {
+    if (!s.vcu.ebs_fired()) return;
+    e.fired = true;
+    e.cause = s.vcu.ebs_cause();
+    e.t = to_seconds(*s.vcu.ebs_fired());
+    e.speed = speed;
+    return;
+  }
+  if (e.stopped_at) return;
+  e.distance += speed * model.dt;
+  if (speed < model.scenario.event.standstill_speed) e.stopped_at = s.t + model.dt;
 }
 
 std::unique_ptr<RawSensors> make_raw_sensors(const SimModel& model) {
@@ -149,6 +194,9 @@ RunResult results_of(const SimState& s) {
   r.fallbacks = s.stack.telemetry().fallbacks;
   r.fault = s.stack.telemetry().last_fault;
   r.cycles = s.control_cycles;
+  r.ebs = s.ebs;
+  r.as_transitions = s.stack.as_machine().transitions();
+  r.health = s.stack.health().events();
   r.energy = s.car.energy;
   const planning::PlanResult& plan = s.stack.last_plan();
   const std::vector<Cone>& plan_cones = s.stack.last_plan_cones();
@@ -192,6 +240,8 @@ SimState::SimState(const SimModel& model, WireTap* tap)
       event(model.scenario.scenario.event, model.track, model.scenario.event),
       stack(model.stack, model.mission),
       hal(model.stack.autonomy.slam == stack::SlamMode::GroundTruth, make_wire(model.scenario)),
+      vcu(model.scenario.vcu, stack::mission_code(model.mission.mission)),
+      faults(model.scenario.faults, stream_seed(model.scenario.scenario.seed, "faults")),
       cone_sensor(model.cone_sensor, stream_seed(model.scenario.scenario.seed, "cone_sensor")),
       cones_now(model.cones.size()),
       cones_knocked(model.cones.size()),
@@ -226,6 +276,7 @@ void step(const SimModel& model, SimState& s) {
   const Pose2 base = vehicle::base_pose(car, s.car);
   const Vec2 v_world = rotate(vehicle::base_velocity(car, s.car), base.yaw);
   s.cones.step(base, v_world.x, v_world.y, s.car.r, model.dt);
+  measure_ebs_stop(model, s, norm(v_world));
   const double t0 = s.t;
   ++s.k;
   s.now = s.k * model.dt_ns;
@@ -266,6 +317,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
 
   RunResult result = results_of(state);
   result.stack_remote = state.hal.remote();
+  result.faults = fault_notes(scenario.faults);
   result.log = std::move(log.rows());
   result.sim_time = result.log.empty() ? 0.0 : result.log.back().t;
   tracking_from_log(result.event.laps, result.log, 1.0 / scenario.sim.log_rate, result.lap_tracking, result.tracking);

@@ -20,6 +20,7 @@
 
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
+#include "sim/runner/faults.h"
 #include "sim/runner/limit_report.h"
 #include "sim/runner/model.h"
 #include "sim/runner/observers.h"
@@ -30,11 +31,38 @@
 #include "sim/sensors/cone_sensor.h"
 #include "sim/sensors/imu.h"
 #include "sim/sensors/odometry_sensors.h"
+#include "sim/vehicle/vcu.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/cone_world.h"
 #include "sim/world/track.h"
 
 namespace paddock::runner {
+
+// the emergency brake system's stop, measured on the car (ground truth)
+struct EbsStop {
+  bool fired = false;
+  std::string cause;                 // what fired it (the VCU's words)
+  double t = 0.0;                    // s, when it fired
+  double speed = 0.0;                // m/s at that instant
+  double distance = 0.0;             // m driven since, to standstill
+  std::optional<double> stopped_at;  // s, at rest (none: still rolling when the run ended)
+  // the mean deceleration from the trigger to rest, v0 / time (m/s^2)
+  double mean_decel() const {
+    return stopped_at && *stopped_at > t ? speed / (*stopped_at - t) : 0.0;
+  }
+};
+
+// the rules' EBS requirement at a speed: the distance within which the car
+// must stop from the EBS's trigger. FS Rules 2024 T 15.3 allow 200 ms from the
+// trigger to the start of braking, and the EBS test (IN 6.3) asks a car at
+// 40 km/h to stop within 10 m of the RES's trigger: 200 ms of reaction and a
+// mean deceleration of 8 m/s^2 give 9.94 m there, so those two figures are
+// the requirement at any speed
+inline constexpr double kEbsRulesReaction = 0.2;  // s
+inline constexpr double kEbsRulesDecel = 8.0;     // m/s^2
+inline double ebs_rules_distance(double speed) {
+  return speed * kEbsRulesReaction + speed * speed / (2.0 * kEbsRulesDecel);
+}
 
 struct SimState {
   // the world at t = 0 (car at the start pose, at rest, brakes on; cones in
@@ -57,7 +85,12 @@ struct SimState {
   SimHal hal;
   vehicle::DriverInput input{0.0, 0.0, 1.0};  // the stack's last command, as the actuators take it
   hal::AsState as_state = hal::AsState::Off;
+  // the car's VCU and EBS between the stack's command and the actuators
+  vehicle::Vcu vcu;
+  std::optional<TimeNs> ready_since;  // when the car first showed AS Ready (the official's clock)
   bool go_sent = false;
+  EbsStop ebs;
+  FaultInjector faults;  // [faults] at work
   int control_cycles = 0;
   // what the current instant ran
   bool controlled = false;  // a control cycle
@@ -119,6 +152,13 @@ struct RunResult {
   int fallbacks = 0;       // control cycles in the safe stop
   std::string fault;       // the stack's last fault, if any
   int cycles = 0;          // control cycles run
+  EbsStop ebs;             // the EBS's stop, if it fired
+  // the stack's AS state machine: its transitions (none when the stack runs
+  // in the car binary)
+  std::vector<stack::AsTransition> as_transitions;
+  // the faults injected ([faults]), and what the stack noticed of its inputs
+  std::vector<FaultNote> faults;
+  std::vector<stack::HealthEvent> health;
   // transport = udp: the stack ran in the car binary, so what is measured
   // inside it (tracking, the estimate, the map, fallbacks, perception) is
   // not known here

@@ -20,7 +20,8 @@ WireLink::WireLink(const std::optional<hal::ouster::SensorInfo>& lidar, const ha
 
 bool WireLink::on_can(const hal::SensorMessage& m) {
   return std::holds_alternative<hal::Imu>(m) || std::holds_alternative<hal::WheelSpeeds>(m) ||
-         std::holds_alternative<hal::SteeringAngle>(m) || std::holds_alternative<hal::ResSignal>(m);
+         std::holds_alternative<hal::SteeringAngle>(m) || std::holds_alternative<hal::ResSignal>(m) ||
+         std::holds_alternative<hal::VcuStatus>(m);
 }
 
 // one frame onto the bus and off it: the 16 bytes of struct can_frame, read
@@ -43,7 +44,7 @@ void WireLink::carry(const hal::SensorMessage& m, std::deque<hal::SensorMessage>
         if constexpr (std::is_same_v<T, hal::Imu>) {
           return vcu_.encode(msg);
         } else if constexpr (std::is_same_v<T, hal::WheelSpeeds> || std::is_same_v<T, hal::SteeringAngle> ||
-                             std::is_same_v<T, hal::ResSignal>) {
+                             std::is_same_v<T, hal::ResSignal> || std::is_same_v<T, hal::VcuStatus>) {
           return {vcu_.encode(msg)};
         } else {
           throw std::logic_error("WireLink::carry: not a message of the CAN bus");

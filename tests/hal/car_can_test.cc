@@ -72,10 +72,11 @@ CanFrame received(CanFrame f, TimeNs stamp) {
 TEST(CarCan, ShippedDbcParsesAndIsTheCars) {
   const Dbc dbc = parse_dbc(shipped(), kSource);
   EXPECT_EQ(dbc.nodes, (std::vector<std::string>{"VCU", "ACU"}));
-  ASSERT_EQ(dbc.messages.size(), 6u);
+  ASSERT_EQ(dbc.messages.size(), 7u);
   EXPECT_NE(dbc.comment.find("paddock's own car bus"), std::string::npos);
-  // priorities: the RES first, then the command, then the sensors
+  // priorities: the RES first, the safety chain's status, then the command, then the sensors
   EXPECT_EQ(dbc.find("RES_Status")->id, 0x010u);
+  EXPECT_EQ(dbc.find("VCU_Status")->id, 0x020u);
   EXPECT_EQ(dbc.find("ACU_Command")->id, 0x100u);
   EXPECT_EQ(dbc.find("IMU_Accel")->id, 0x180u);
   EXPECT_EQ(dbc.find("IMU_Rate")->id, 0x181u);
@@ -145,6 +146,18 @@ TEST(CarCan, EveryMessageRoundTripsWithinHalfAStep) {
     EXPECT_EQ(r.go, res.go);
     EXPECT_EQ(r.emergency, res.emergency);
 
+    // the EBS tank's 0..20 bar, the brake lines' 0..200 bar, every mission
+    const double bar = step("VCU_Status", "EbsPressure");
+    const VcuStatus vs{t, i % 2 == 1, static_cast<MissionCode>(i % 8), u(0, 20), u(0, 200), u(0, 200)};
+    can.push(can.encode(vs));
+    const VcuStatus st = only_sensor<VcuStatus>(can);
+    EXPECT_EQ(st.stamp, t);
+    EXPECT_EQ(st.asms_on, vs.asms_on);
+    EXPECT_EQ(st.mission, vs.mission);
+    EXPECT_NEAR(st.ebs_pressure, vs.ebs_pressure, bar / 2 * (1 + 1e-9));
+    EXPECT_NEAR(st.brake_pressure_front, vs.brake_pressure_front, step("VCU_Status", "BrakePressureFront") / 2 * (1 + 1e-9));
+    EXPECT_NEAR(st.brake_pressure_rear, vs.brake_pressure_rear, step("VCU_Status", "BrakePressureRear") / 2 * (1 + 1e-9));
+
     const ActuatorCommand cmd{t, u(-0.6, 0.6), u(0, 1), u(0, 1), u(-3000, 3000), static_cast<AsState>(i % 5)};
     can.push(can.encode(cmd));
     const auto c = can.pop_command();
@@ -160,8 +173,9 @@ TEST(CarCan, EveryMessageRoundTripsWithinHalfAStep) {
   const CarCanCounters& n = can.counters();
   EXPECT_EQ(n.imu, 2000u);
   EXPECT_EQ(n.commands, 2000u);
-  EXPECT_EQ(n.frames, 6u * 2000u);
-  EXPECT_EQ(n.encoded, 6u * 2000u);
+  EXPECT_EQ(n.vcu_status, 2000u);
+  EXPECT_EQ(n.frames, 7u * 2000u);
+  EXPECT_EQ(n.encoded, 7u * 2000u);
   EXPECT_EQ(n.saturated + n.nonfinite + n.unknown_id + n.bad_dlc + n.bad_value + n.unmatched_imu_halves, 0u);
 }
 

@@ -62,8 +62,9 @@ TEST(RunLog, TheOfficialReaderReadsTheRunsLogWithEveryTopic) {
   EXPECT_EQ(topics.at("/lidar/points").get<long>(), (rotations + 4) / 5);
   EXPECT_EQ(topics.at("/stack/command").get<long>(), cycles);
   EXPECT_EQ(topics.at("/can/tx").get<long>(), cycles);
-  // the IMU's two frames at 200 Hz, wheels and steering at 100 Hz, the RES's go
-  EXPECT_EQ(topics.at("/can/rx").get<long>(), 2 * (2 * cycles - 1) + cycles + cycles + 1);
+  // the IMU's two frames at 200 Hz, wheels and steering at 100 Hz, the VCU's
+  // status at 50 Hz, the RES's go
+  EXPECT_EQ(topics.at("/can/rx").get<long>(), 2 * (2 * cycles - 1) + cycles + cycles + (cycles + 1) / 2 + 1);
   EXPECT_EQ(topics.at("/hal/detections").get<long>(), rotations);
   EXPECT_EQ(topics.at("/camera/image").get<long>(), rotations);  // the LiDAR triggers the camera once a rotation
   for (const char* topic : {"/tf", "/stack/pose", "/truth/pose", "/stack/map", "/stack/path", "/truth/cones"})
@@ -92,7 +93,8 @@ TEST(RunLog, TheReplayGivesTheLiveRunsCommandsBitForBit) {
   // a changed stack on the same log: it steers otherwise from the go on
   const testing::Outcome changed = testing::run_paddock("replay " + log.string() + " --set control.stanley.k=3");
   ASSERT_EQ(changed.code, 0) << changed.output;
-  EXPECT_NE(changed.output.find("the first difference at 5.000 s"), std::string::npos) << changed.output;
+  // (the go: 5 s after the car showed AS Ready at 0.5 s)
+  EXPECT_NE(changed.output.find("the first difference at 5.500 s"), std::string::npos) << changed.output;
   // a window: the first 6 s only
   const testing::Outcome head = testing::run_paddock("replay " + log.string() + " --until 6");
   EXPECT_NE(head.output.find("601 compared with the log: all identical"), std::string::npos) << head.output;

@@ -14,18 +14,33 @@
 namespace paddock::stack {
 namespace {
 
-// a HAL whose messages the test posts and whose commands it reads
+// a HAL whose messages the test posts and whose commands it reads; the car
+// behind it reports (once per control cycle, after the test's messages) its
+// ASMS on, `mission` selected, the EBS armed and the brakes closed, as a car
+// ready to drive does (unless vcu is reset)
 class ScriptedHal final : public hal::Hal {
  public:
+  explicit ScriptedHal(hal::MissionCode mission = hal::MissionCode::Trackdrive)
+      : vcu(hal::VcuStatus{0, true, mission, 10.0, 100.0, 100.0}) {}
   std::deque<hal::SensorMessage> inbox;
   std::vector<hal::ActuatorCommand> sent;
+  std::optional<hal::VcuStatus> vcu;
   std::optional<hal::SensorMessage> receive() override {
-    if (inbox.empty()) return std::nullopt;
+    if (inbox.empty()) {
+      // one status at the end of each drain
+      vcu_given_ = !vcu_given_;
+      if (vcu_given_ && vcu) return *vcu;
+      vcu_given_ = false;
+      return std::nullopt;
+    }
     auto m = inbox.front();
     inbox.pop_front();
     return m;
   }
   void send(const hal::ActuatorCommand& c) override { sent.push_back(c); }
+
+ private:
+  bool vcu_given_ = false;
 };
 
 std::vector<Vec2> circle(double r, int n) {
@@ -44,10 +59,12 @@ MissionSpec circle_mission(int crossings) {
   return m;
 }
 
-// these tests drive the oracle planner: the path is given
+// these tests drive the oracle planner: the path is given; the go counts at
+// once (the rules' 5 s in AS Ready is tested on its own)
 StackParams oracle_params() {
   StackParams p;
   p.autonomy.planner = PlannerMode::Oracle;
+  p.as.ready_wait = 0.0;
   return p;
 }
 
@@ -94,10 +111,11 @@ TEST(Stack, StaleStateGivesTheSafeStopAndCountsIt) {
   hal.inbox.push_back(state_at(0, {0, 0}, 0.0, 5.0));
   hal.inbox.push_back(hal::ResSignal{0, true, false});
   s.tick(0, hal);
-  // no estimate for 0.5 s (the timeout is 0.2 s)
-  s.tick(500'000'000, hal);
+  // no estimate for 0.21 s (the timeout is 0.2 s); the cycles run on time
+  for (TimeNs t = 10'000'000; t <= 210'000'000; t += 10'000'000) s.tick(t, hal);
   EXPECT_EQ(hal.sent.back().brake, 1.0);
   EXPECT_EQ(hal.sent.back().steering_angle, 0.0);
+  EXPECT_EQ(hal.sent.back().as_state, hal::AsState::Driving);  // a fallback, not an emergency
   EXPECT_EQ(s.telemetry().fallbacks, 1);
   EXPECT_NE(s.telemetry().last_fault.find("stale"), std::string::npos);
 }
@@ -171,9 +189,9 @@ std::vector<Cone> corridor(double x_last) {
 // see(i, rel, x) gives a colour (rel: the cone in the base frame, x: the
 // car's); after(x) runs after every tick.
 template <class See, class After>
-void drive_corridor(Stack& s, const std::vector<Cone>& track, double x0, double x_stop, int seconds, See see,
-                    After after) {
-  ScriptedHal hal;
+void drive_corridor(Stack& s, Mission mission, const std::vector<Cone>& track, double x0, double x_stop, int seconds,
+                    See see, After after) {
+  ScriptedHal hal(mission_code(mission));
   const double v = 5.0;
   for (int k = 0; k < 100 * seconds; ++k) {
     const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
@@ -204,6 +222,7 @@ void drive_corridor(Stack& s, const std::vector<Cone>& track, double x0, double 
 TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
   StackParams p;
   p.autonomy.planner = PlannerMode::Delaunay;
+  p.as.ready_wait = 0.0;
   MissionSpec m;
   m.mission = Mission::Autocross;
   m.finish_crossings = 2;
@@ -216,7 +235,7 @@ TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
   track.push_back({{30.0, -2.6}, ConeColor::BigOrange});
   int learned_max = 0;
   drive_corridor(
-      s, track, 0.0, 45.0, 10,
+      s, m.mission, track, 0.0, 45.0, 10,
       [&](std::size_t i, Vec2 rel, double x) -> std::optional<ConeColor> {
         // the cones within 20 m ahead; the fake pair small once the car is near
         if (rel.x < -2.0 || rel.x > 20.0) return std::nullopt;
@@ -240,6 +259,7 @@ TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
 TEST(Stack, AGateSeenOnlyAfterTheCarCrossedItCounts) {
   StackParams p;
   p.autonomy.planner = PlannerMode::Delaunay;
+  p.as.ready_wait = 0.0;
   MissionSpec m;
   m.mission = Mission::Acceleration;
   m.finish_crossings = 2;
@@ -252,7 +272,7 @@ TEST(Stack, AGateSeenOnlyAfterTheCarCrossedItCounts) {
   track.push_back({{30.0, -2.6}, ConeColor::BigOrange});
   int crossings_at_10 = -1;
   drive_corridor(
-      s, track, -2.0, 45.0, 12,
+      s, m.mission, track, -2.0, 45.0, 12,
       [&](std::size_t i, Vec2 rel, double) -> std::optional<ConeColor> {
         // the start gate only from behind, everything else 3-20 m ahead
         const bool seen = i == start_left || i == start_left + 1 ? rel.x < -1.0 && rel.x > -8.0

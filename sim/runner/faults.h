@@ -1,0 +1,228 @@
+#pragma once
+// timed faults ([faults]): what goes wrong on the car during a run, injected
+// between the simulated hardware and the HAL, seeded like every random draw of
+// the run (stream "faults"). Each kind is a section of its own; a kind whose
+// `at` is unset is not injected. Times are the run's sim time (s, the log's
+// t); a duration of 0 lasts to the end of the run.
+//
+//   [faults.lidar]     dropout: whole rotations, an azimuth sector, or a band of rings
+//   [faults.camera]    dead (no detections) or frozen (the same image, newly stamped)
+//   [faults.imu]       a bias step on the accelerometer and gyro, and spikes
+//   [faults.wheel]     one wheel-speed sensor stuck at its last value, or noisy
+//   [faults.steering]  an offset on the steering sensor, or on the actuator
+//   [faults.control]   the stack's computer stalls: no control cycle runs
+//   [faults.can]       a share of the VCU's CAN frames lost
+//   [faults.res]       the RES's emergency stop pressed
+//   [faults.ebs]       the EBS's tank loses its pressure
+#include <cstdint>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "autonomy/common/params.h"
+#include "autonomy/common/time.h"
+#include "autonomy/hal/messages.h"
+#include "sim/sensors/lidar.h"
+#include "sim/vehicle/vehicle.h"
+
+namespace paddock::runner {
+
+// when a fault is on: from `at` for `duration` (0: to the end)
+struct FaultWindow {
+  std::optional<double> at;
+  double duration = 0.0;
+  bool on(double t) const { return at && t >= *at && (duration <= 0.0 || t < *at + duration); }
+};
+
+#define PADDOCK_FAULT_WINDOW(v, what)                                                                         \
+  v(PADDOCK_PARAM(at), {"s", params::at_least(0.0), "sim time the " what " begins (unset: no such fault)"}); \
+  v(PADDOCK_PARAM(duration), {"s", params::at_least(0.0), "how long it lasts (0: to the end of the run)"})
+
+enum class LidarDropout { Rotations, Sector, Rings };
+struct LidarFault : FaultWindow {
+  LidarDropout mode = LidarDropout::Rotations;
+  double sector_from = -0.5;  // rad, sensor azimuth (0 ahead, > 0 left)
+  double sector_to = 0.5;
+  int ring_first = 0;
+  int ring_last = 15;
+
+  static constexpr params::Choice<LidarDropout> kModes[] = {
+      {"rotations", LidarDropout::Rotations}, {"sector", LidarDropout::Sector}, {"rings", LidarDropout::Rings}};
+  template <class V>
+  void visit(V& v) {
+    PADDOCK_FAULT_WINDOW(v, "LiDAR dropout");
+    v(PADDOCK_PARAM(mode), kModes, "rotations: no packets at all; sector: no returns in [sector_from, sector_to]; rings: none from rings ring_first..ring_last");
+    v(PADDOCK_PARAM(sector_from), {"rad", params::in(-3.1416, 3.1416), "mode = sector: the sector's first azimuth (0 ahead, > 0 left)"});
+    v(PADDOCK_PARAM(sector_to), {"rad", params::in(-3.1416, 3.1416), "mode = sector: its last azimuth (counter-clockwise from sector_from)"});
+    v(PADDOCK_PARAM(ring_first), {"", params::in(0, 1023), "mode = rings: the lowest ring lost"});
+    v(PADDOCK_PARAM(ring_last), {"", params::in(0, 1023), "mode = rings: the highest ring lost"});
+  }
+  std::string check() const { return ring_last < ring_first ? "ring_last must be at least ring_first" : ""; }
+};
+
+enum class CameraFaultMode { Dead, Frozen };
+struct CameraFault : FaultWindow {
+  CameraFaultMode mode = CameraFaultMode::Dead;
+  static constexpr params::Choice<CameraFaultMode> kModes[] = {{"dead", CameraFaultMode::Dead},
+                                                               {"frozen", CameraFaultMode::Frozen}};
+  template <class V>
+  void visit(V& v) {
+    PADDOCK_FAULT_WINDOW(v, "camera fault");
+    v(PADDOCK_PARAM(mode), kModes, "dead: no frames, so no detections; frozen: the last image again, newly stamped");
+  }
+};
+
+struct ImuFault : FaultWindow {
+  double bias_ax = 0.0;        // m/s^2 added
+  double bias_ay = 0.0;
+  double bias_yaw_rate = 0.0;  // rad/s added
+  double spike_rate = 0.0;     // spikes a second
+  double spike_accel = 0.0;    // m/s^2, a spike's size on ax and ay (random sign)
+  double spike_yaw_rate = 0.0; // rad/s, on the yaw rate
+  template <class V>
+  void visit(V& v) {
+    PADDOCK_FAULT_WINDOW(v, "IMU fault");
+    v(PADDOCK_PARAM(bias_ax), {"m/s^2", params::in(-50.0, 50.0), "a step on the forward accelerometer's bias"});
+    v(PADDOCK_PARAM(bias_ay), {"m/s^2", params::in(-50.0, 50.0), "a step on the lateral accelerometer's bias"});
+    v(PADDOCK_PARAM(bias_yaw_rate), {"rad/s", params::in(-5.0, 5.0), "a step on the gyro's yaw-rate bias"});
+    v(PADDOCK_PARAM(spike_rate), {"Hz", params::in(0.0, 10000.0), "spikes a second (each sample: probability rate x period)"});
+    v(PADDOCK_PARAM(spike_accel), {"m/s^2", params::in(0.0, 500.0), "a spike's size on ax and ay"});
+    v(PADDOCK_PARAM(spike_yaw_rate), {"rad/s", params::in(0.0, 50.0), "a spike's size on the yaw rate"});
+  }
+};
+
+enum class WheelFaultMode { Stuck, Noisy };
+struct WheelFault : FaultWindow {
+  int wheel = 0;  // 0 FL, 1 FR, 2 RL, 3 RR
+  WheelFaultMode mode = WheelFaultMode::Stuck;
+  double noise = 5.0;  // rad/s, standard deviation
+  static constexpr params::Choice<WheelFaultMode> kModes[] = {{"stuck", WheelFaultMode::Stuck},
+                                                              {"noisy", WheelFaultMode::Noisy}};
+  template <class V>
+  void visit(V& v) {
+    PADDOCK_FAULT_WINDOW(v, "wheel-speed fault");
+    v(PADDOCK_PARAM(wheel), {"", params::in(0, 3), "the sensor: 0 front left, 1 front right, 2 rear left, 3 rear right"});
+    v(PADDOCK_PARAM(mode), kModes, "stuck: it repeats its last reading; noisy: white noise added");
+    v(PADDOCK_PARAM(noise), {"rad/s", params::in(0.0, 1000.0), "mode = noisy: the noise's standard deviation"});
+  }
+};
+
+enum class SteeringFaultMode { Sensor, Actuator };
+struct SteeringFault : FaultWindow {
+  SteeringFaultMode mode = SteeringFaultMode::Sensor;
+  double offset = 0.0;  // rad
+  static constexpr params::Choice<SteeringFaultMode> kModes[] = {{"sensor", SteeringFaultMode::Sensor},
+                                                                 {"actuator", SteeringFaultMode::Actuator}};
+  template <class V>
+  void visit(V& v) {
+    PADDOCK_FAULT_WINDOW(v, "steering offset");
+    v(PADDOCK_PARAM(mode), kModes, "sensor: the measured angle is off; actuator: the road wheels are off the request (the sensor reads them true)");
+    v(PADDOCK_PARAM(offset), {"rad", params::in(-0.5, 0.5), "the offset, > 0 left"});
+  }
+};
+
+struct ControlFault : FaultWindow {
+  template <class V>
+  void visit(V& v) {
+    PADDOCK_FAULT_WINDOW(v, "stall of the stack's computer (no control cycle)");
+  }
+};
+
+struct CanFault : FaultWindow {
+  double loss = 0.5;  // share of the VCU's frames lost
+  template <class V>
+  void visit(V& v) {
+    PADDOCK_FAULT_WINDOW(v, "CAN frame loss");
+    v(PADDOCK_PARAM(loss), {"", params::fraction(), "the share of the VCU's frames (IMU, wheels, steering, RES, status) lost"});
+  }
+};
+
+struct ResFault {
+  std::optional<double> at;
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(at), {"s", params::at_least(0.0), "sim time the RES's emergency stop is pressed (unset: never)"});
+  }
+};
+
+struct EbsFault {
+  std::optional<double> at;
+  double pressure = 0.0;  // bar left in the tank
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(at), {"s", params::at_least(0.0), "sim time the EBS's tank loses its pressure (unset: never)"});
+    v(PADDOCK_PARAM(pressure), {"bar", params::in(0.0, 40.0), "the pressure left"});
+  }
+};
+
+// [faults]
+struct FaultsSection {
+  LidarFault lidar;
+  CameraFault camera;
+  ImuFault imu;
+  WheelFault wheel;
+  SteeringFault steering;
+  ControlFault control;
+  CanFault can;
+  ResFault res;
+  EbsFault ebs;
+
+  template <class V>
+  void visit(V& v) {
+    v.section(PADDOCK_PARAM(lidar), "a LiDAR dropout: rotations, a sector, rings");
+    v.section(PADDOCK_PARAM(camera), "a dead or frozen camera");
+    v.section(PADDOCK_PARAM(imu), "an IMU bias step and spikes");
+    v.section(PADDOCK_PARAM(wheel), "a wheel-speed sensor stuck or noisy");
+    v.section(PADDOCK_PARAM(steering), "a steering offset (sensor or actuator)");
+    v.section(PADDOCK_PARAM(control), "a stall of the stack's computer");
+    v.section(PADDOCK_PARAM(can), "CAN frames lost");
+    v.section(PADDOCK_PARAM(res), "the RES's emergency stop");
+    v.section(PADDOCK_PARAM(ebs), "the EBS losing its pressure");
+  }
+};
+
+// one fault of the scenario, for the summary
+struct FaultNote {
+  std::string name;      // "lidar", "camera", ...
+  std::string what;      // in words
+  double at = 0.0;       // s
+};
+
+// the faults the scenario injects, in words, by time
+std::vector<FaultNote> fault_notes(const FaultsSection& f);
+
+// the faults at work in one run (a SimState's): each sensor's output passes here
+class FaultInjector {
+ public:
+  FaultInjector(const FaultsSection& faults, std::uint64_t seed) : f_(faults), rng_(seed) {}
+
+  // whether the LiDAR sends the rotation that ends at t (s) at all
+  bool lidar_sends(double t) const { return !(f_.lidar.mode == LidarDropout::Rotations && f_.lidar.on(t)); }
+  // drops the points a sector or ring dropout loses (rotation ending at t)
+  void filter_lidar(double t, std::vector<sensors::LidarPoint>& points) const;
+  // the camera at t: true when its frame (and so its detections) is lost
+  bool camera_dead(double t) const { return f_.camera.mode == CameraFaultMode::Dead && f_.camera.on(t); }
+  bool camera_frozen(double t) const { return f_.camera.mode == CameraFaultMode::Frozen && f_.camera.on(t); }
+  // the sensors' samples at t, as the faults change them
+  void apply(double t, hal::Imu& m, double period);
+  void apply(double t, hal::WheelSpeeds& m);
+  void apply(double t, hal::SteeringAngle& m) const;
+  // the actuators' input: a steering actuator's offset
+  void apply(double t, vehicle::DriverInput& in) const;
+  // whether the stack's computer runs its cycle at t
+  bool control_runs(double t) const { return !f_.control.on(t); }
+  // whether a CAN frame sent at t arrives
+  bool can_delivers(double t);
+  bool res_pressed(double t) const { return f_.res.at && t >= *f_.res.at; }
+  std::optional<double> ebs_tank(double t) const {
+    return f_.ebs.at && t >= *f_.ebs.at ? std::optional<double>(f_.ebs.pressure) : std::nullopt;
+  }
+
+ private:
+  FaultsSection f_;
+  std::mt19937_64 rng_;
+  std::optional<double> stuck_;  // the stuck wheel's frozen reading
+};
+
+}  // namespace paddock::runner

@@ -1,0 +1,128 @@
+// the fault injector against brute force: a sector and a band of rings drop
+// exactly the points in them, a window is on from `at` for `duration`, a
+// stuck wheel repeats its first faulty reading, the CAN's loss share is what
+// was asked (binomial bounds), and the summary's words name every fault
+#include "sim/runner/faults.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace paddock::runner {
+namespace {
+
+std::vector<sensors::LidarPoint> ring_of_points() {
+  std::vector<sensors::LidarPoint> pts;
+  for (int ring = 0; ring < 32; ++ring) {
+    for (int a = 0; a < 360; ++a) {
+      const double az = (a + 0.5) * kPi / 180.0 - kPi;
+      sensors::LidarPoint p{};
+      p.x = static_cast<float>(10.0 * std::cos(az));
+      p.y = static_cast<float>(10.0 * std::sin(az));
+      p.ring = static_cast<std::uint16_t>(ring);
+      pts.push_back(p);
+    }
+  }
+  return pts;
+}
+
+TEST(Faults, AWindowIsOnFromAtForItsDuration) {
+  FaultWindow w;
+  EXPECT_FALSE(w.on(0.0));
+  w.at = 2.0;
+  w.duration = 0.5;
+  EXPECT_FALSE(w.on(1.999));
+  EXPECT_TRUE(w.on(2.0));
+  EXPECT_TRUE(w.on(2.499));
+  EXPECT_FALSE(w.on(2.5));
+  w.duration = 0.0;
+  EXPECT_TRUE(w.on(1e6));
+}
+
+TEST(Faults, ASectorOrABandOfRingsLosesExactlyItsPoints) {
+  FaultsSection f;
+  f.lidar.at = 1.0;
+  f.lidar.mode = LidarDropout::Sector;
+  f.lidar.sector_from = 3.0;  // across the +-pi seam: 3.0 .. -3.0 (0.28 rad)
+  f.lidar.sector_to = -3.0;
+  FaultInjector sector(f, 1);
+  std::vector<sensors::LidarPoint> pts = ring_of_points();
+  sector.filter_lidar(0.5, pts);
+  EXPECT_EQ(pts.size(), 32u * 360u);  // not yet on
+  sector.filter_lidar(1.5, pts);
+  std::size_t expected = 0;
+  for (const sensors::LidarPoint& p : ring_of_points()) {
+    const double az = std::atan2(p.y, p.x);
+    expected += std::abs(az) < 3.0 ? 1 : 0;
+  }
+  EXPECT_EQ(pts.size(), expected);
+  EXPECT_EQ(32u * 360u - expected, 32u * 16u);  // 16 one-degree columns per ring in 0.283 rad
+  f.lidar.mode = LidarDropout::Rings;
+  f.lidar.ring_first = 4;
+  f.lidar.ring_last = 11;
+  FaultInjector rings(f, 1);
+  pts = ring_of_points();
+  rings.filter_lidar(1.5, pts);
+  EXPECT_EQ(pts.size(), 24u * 360u);
+  for (const sensors::LidarPoint& p : pts) EXPECT_TRUE(p.ring < 4 || p.ring > 11);
+  EXPECT_TRUE(rings.lidar_sends(1.5));
+  f.lidar.mode = LidarDropout::Rotations;
+  EXPECT_FALSE(FaultInjector(f, 1).lidar_sends(1.5));
+}
+
+TEST(Faults, AStuckWheelRepeatsItsReadingAndTheOthersGoOn) {
+  FaultsSection f;
+  f.wheel.at = 1.0;
+  f.wheel.duration = 1.0;
+  f.wheel.wheel = 2;
+  FaultInjector inj(f, 1);
+  for (int k = 0; k < 300; ++k) {
+    const double t = k * 0.01;
+    hal::WheelSpeeds w{0, {t, t, t, t}};
+    inj.apply(t, w);
+    EXPECT_EQ(w.omega[0], t);
+    EXPECT_EQ(w.omega[2], f.wheel.on(t) ? 1.0 : t) << t;
+  }
+}
+
+TEST(Faults, TheCanLosesTheShareAskedAndNothingOutsideItsWindow) {
+  FaultsSection f;
+  f.can.at = 1.0;
+  f.can.duration = 1.0;
+  f.can.loss = 0.3;
+  FaultInjector inj(f, 7);
+  int lost = 0;
+  const int n = 20000;
+  for (int i = 0; i < n; ++i) lost += inj.can_delivers(1.5) ? 0 : 1;
+  // binomial: 6000 +- 4.5 sigma (sigma = 64.8)
+  EXPECT_NEAR(lost, 0.3 * n, 4.5 * std::sqrt(n * 0.3 * 0.7));
+  for (int i = 0; i < 1000; ++i) EXPECT_TRUE(inj.can_delivers(0.5) && inj.can_delivers(2.0));
+}
+
+TEST(Faults, TheImuStepAddsItsBiasAndTheNotesNameEveryFault) {
+  FaultsSection f;
+  f.imu.at = 3.0;
+  f.imu.bias_ax = 0.3;
+  f.imu.bias_yaw_rate = -0.01;
+  FaultInjector inj(f, 1);
+  hal::Imu m;
+  inj.apply(2.0, m, 0.005);
+  EXPECT_EQ(m.ax, 0.0);
+  inj.apply(3.0, m, 0.005);
+  EXPECT_EQ(m.ax, 0.3);
+  EXPECT_EQ(m.yaw_rate, -0.01);
+  f.res.at = 10.0;
+  f.camera.at = 5.0;
+  f.camera.mode = CameraFaultMode::Frozen;
+  const std::vector<FaultNote> notes = fault_notes(f);
+  ASSERT_EQ(notes.size(), 3u);
+  EXPECT_EQ(notes[0].name, "imu");  // by time
+  EXPECT_EQ(notes[1].name, "camera");
+  EXPECT_EQ(notes[1].what, "camera frozen to the end");
+  EXPECT_EQ(notes[2].name, "res");
+  EXPECT_EQ(notes[2].at, 10.0);
+}
+
+}  // namespace
+}  // namespace paddock::runner
