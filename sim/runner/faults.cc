@@ -60,11 +60,70 @@ std::vector<FaultNote> fault_notes(const FaultsSection& f) {
   if (f.can.at) n.push_back({"can", num(100.0 * f.can.loss) + " % of the VCU's CAN frames lost" + window(f.can), *f.can.at});
   if (f.res.at) n.push_back({"res", "RES emergency stop pressed", *f.res.at});
   if (f.ebs.at) n.push_back({"ebs", "EBS tank pressure drops to " + num(f.ebs.pressure) + " bar", *f.ebs.at});
+  if (f.cones.at) n.push_back({"cones", std::to_string(f.cones.wrong_colour) + " cones of the wrong colour (blue and yellow swapped)", *f.cones.at});
+  if (f.object.at) {
+    n.push_back({"object", std::string(f.object.kind == ObjectKind::Bag ? "a bag" : "a person's legs") + " by the " +
+                               (f.object.left ? "left" : "right") + " boundary, " + num(f.object.along) + " m along the centreline",
+                 *f.object.at});
+  }
+  if (f.rain.at) {
+    n.push_back({"rain", "rain: " + num(100.0 * f.rain.returns_lost) + " % of the LiDAR's returns lost, grip x " + num(f.rain.grip) + window(f.rain),
+                 *f.rain.at});
+  }
   std::stable_sort(n.begin(), n.end(), [](const FaultNote& a, const FaultNote& b) { return a.at < b.at; });
   return n;
 }
 
-void FaultInjector::filter_lidar(double t, std::vector<sensors::LidarPoint>& points) const {
+void FaultInjector::place(const world::TrackModel& track, const std::vector<Cone>& cones) {
+  object_.clear();
+  recoloured_.clear();
+  if (f_.object.at && track.centreline.size() >= 2) {
+    // the centreline point `along` m from its start, and its normal
+    std::size_t i = 1;
+    double s = 0.0;
+    while (i + 1 < track.centreline.size() && s + distance(track.centreline[i - 1], track.centreline[i]) < f_.object.along) {
+      s += distance(track.centreline[i - 1], track.centreline[i]);
+      ++i;
+    }
+    const Vec2 a = track.centreline[i - 1], b = track.centreline[i];
+    const double yaw = std::atan2(b.y - a.y, b.x - a.x);
+    const Vec2 normal{-std::sin(yaw), std::cos(yaw)};  // left
+    const double half = i < track.width.size() ? 0.5 * track.width[i] : 1.5;
+    const Vec2 at = a + normal * ((f_.object.left ? 1.0 : -1.0) * (half + f_.object.edge_offset));
+    if (f_.object.kind == ObjectKind::Bag) {
+      object_.push_back({at, yaw, 0.4, 0.3, 0.3});
+    } else {
+      const Vec2 d{std::cos(yaw), std::sin(yaw)};
+      object_.push_back({at + d * 0.125, yaw, 0.12, 0.12, 0.9});
+      object_.push_back({at - d * 0.125, yaw, 0.12, 0.12, 0.9});
+    }
+  }
+  if (f_.cones.at && f_.cones.wrong_colour > 0) {
+    std::vector<int> sides;
+    for (std::size_t i = 0; i < cones.size(); ++i)
+      if (cones[i].color == ConeColor::Blue || cones[i].color == ConeColor::Yellow) sides.push_back(static_cast<int>(i));
+    // a seeded partial shuffle: the first wrong_colour of them
+    const std::size_t n = std::min(sides.size(), static_cast<std::size_t>(f_.cones.wrong_colour));
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::size_t j = k + static_cast<std::size_t>(rng_() % (sides.size() - k));
+      std::swap(sides[k], sides[j]);
+    }
+    recoloured_.assign(sides.begin(), sides.begin() + static_cast<std::ptrdiff_t>(n));
+    std::sort(recoloured_.begin(), recoloured_.end());
+  }
+}
+
+ConeColor FaultInjector::colour(int i, ConeColor color, double t) const {
+  if (!f_.cones.at || t < *f_.cones.at || !std::binary_search(recoloured_.begin(), recoloured_.end(), i)) return color;
+  return color == ConeColor::Blue ? ConeColor::Yellow : color == ConeColor::Yellow ? ConeColor::Blue : color;
+}
+
+void FaultInjector::filter_lidar(double t, std::vector<sensors::LidarPoint>& points) {
+  if (f_.rain.on(t) && f_.rain.returns_lost > 0.0) {
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    points.erase(std::remove_if(points.begin(), points.end(), [&](const sensors::LidarPoint&) { return u(rng_) < f_.rain.returns_lost; }),
+                 points.end());
+  }
   const LidarFault& l = f_.lidar;
   if (!l.on(t) || l.mode == LidarDropout::Rotations) return;
   const auto lost = [&l](const sensors::LidarPoint& p) {

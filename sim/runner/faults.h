@@ -14,6 +14,9 @@
 //   [faults.can]       a share of the VCU's CAN frames lost
 //   [faults.res]       the RES's emergency stop pressed
 //   [faults.ebs]       the EBS's tank loses its pressure
+//   [faults.cones]     cones of the wrong colour (blue and yellow swapped)
+//   [faults.object]    a spectator's object by the track edge: a bag, a person's legs
+//   [faults.rain]      rain: LiDAR returns lost, the tyres' grip down
 #include <cstdint>
 #include <optional>
 #include <random>
@@ -25,6 +28,8 @@
 #include "autonomy/hal/messages.h"
 #include "sim/sensors/lidar.h"
 #include "sim/vehicle/vehicle.h"
+#include "sim/world/track.h"
+#include "sim/world/venue.h"
 
 namespace paddock::runner {
 
@@ -156,6 +161,45 @@ struct EbsFault {
   }
 };
 
+struct ConesFault {
+  std::optional<double> at;
+  int wrong_colour = 4;  // blue and yellow cones whose colour is swapped
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(at), {"s", params::at_least(0.0), "sim time from which cones stand in the wrong colour (unset: never)"});
+    v(PADDOCK_PARAM(wrong_colour), {"", params::in(0, 10000), "how many blue or yellow cones, drawn at random, show the other colour"});
+  }
+};
+
+enum class ObjectKind { Bag, Legs };
+struct ObjectFault {
+  std::optional<double> at;
+  ObjectKind kind = ObjectKind::Legs;
+  double along = 60.0;       // m along the centreline from its start
+  double edge_offset = 0.3;  // m beyond the boundary (> 0 outside the track)
+  bool left = true;
+  static constexpr params::Choice<ObjectKind> kKinds[] = {{"bag", ObjectKind::Bag}, {"legs", ObjectKind::Legs}};
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(at), {"s", params::at_least(0.0), "sim time from which the object stands there (unset: never)"});
+    v(PADDOCK_PARAM(kind), kKinds, "bag: a 0.4 x 0.3 x 0.3 m box; legs: two 0.12 m posts 0.9 m high, 0.25 m apart");
+    v(PADDOCK_PARAM(along), {"m", params::at_least(0.0), "where: this far along the centreline from its start"});
+    v(PADDOCK_PARAM(edge_offset), {"m", params::in(-2.0, 20.0), "this far beyond the boundary (> 0 outside the track)"});
+    v(PADDOCK_PARAM(left), "by the left boundary (false: the right)");
+  }
+};
+
+struct RainFault : FaultWindow {
+  double returns_lost = 0.3;  // share of the LiDAR's returns
+  double grip = 0.6;          // factor on the tyres' peak friction
+  template <class V>
+  void visit(V& v) {
+    PADDOCK_FAULT_WINDOW(v, "rain");
+    v(PADDOCK_PARAM(returns_lost), {"", params::fraction(), "the share of the LiDAR's returns the spray and drops take"});
+    v(PADDOCK_PARAM(grip), {"", params::in(0.1, 1.0), "the tyres' peak friction (lateral and longitudinal) is this times the dry one"});
+  }
+};
+
 // [faults]
 struct FaultsSection {
   LidarFault lidar;
@@ -167,6 +211,9 @@ struct FaultsSection {
   CanFault can;
   ResFault res;
   EbsFault ebs;
+  ConesFault cones;
+  ObjectFault object;
+  RainFault rain;
 
   template <class V>
   void visit(V& v) {
@@ -179,6 +226,9 @@ struct FaultsSection {
     v.section(PADDOCK_PARAM(can), "CAN frames lost");
     v.section(PADDOCK_PARAM(res), "the RES's emergency stop");
     v.section(PADDOCK_PARAM(ebs), "the EBS losing its pressure");
+    v.section(PADDOCK_PARAM(cones), "cones of the wrong colour");
+    v.section(PADDOCK_PARAM(object), "a spectator's object by the track edge");
+    v.section(PADDOCK_PARAM(rain), "rain: LiDAR returns lost, less grip");
   }
 };
 
@@ -196,11 +246,23 @@ std::vector<FaultNote> fault_notes(const FaultsSection& f);
 class FaultInjector {
  public:
   FaultInjector(const FaultsSection& faults, std::uint64_t seed) : f_(faults), rng_(seed) {}
+  // where the faults meet the world: the object's place by the track, the
+  // cones whose colour is swapped (drawn from `cones`, the event's)
+  void place(const world::TrackModel& track, const std::vector<Cone>& cones);
 
   // whether the LiDAR sends the rotation that ends at t (s) at all
   bool lidar_sends(double t) const { return !(f_.lidar.mode == LidarDropout::Rotations && f_.lidar.on(t)); }
-  // drops the points a sector or ring dropout loses (rotation ending at t)
-  void filter_lidar(double t, std::vector<sensors::LidarPoint>& points) const;
+  // drops the points a sector or ring dropout, or the rain, loses (rotation ending at t)
+  void filter_lidar(double t, std::vector<sensors::LidarPoint>& points);
+  // the colour cone i (of `color`) shows at t
+  ConeColor colour(int i, ConeColor color, double t) const;
+  // the spectator's object at t (none before it comes)
+  const std::vector<world::Block>& objects(double t) const {
+    static const std::vector<world::Block> none;
+    return f_.object.at && t >= *f_.object.at ? object_ : none;
+  }
+  // the tyres' peak friction factor at t (1 dry)
+  double grip(double t) const { return f_.rain.on(t) ? f_.rain.grip : 1.0; }
   // the camera at t: true when its frame (and so its detections) is lost
   bool camera_dead(double t) const { return f_.camera.mode == CameraFaultMode::Dead && f_.camera.on(t); }
   bool camera_frozen(double t) const { return f_.camera.mode == CameraFaultMode::Frozen && f_.camera.on(t); }
@@ -223,6 +285,8 @@ class FaultInjector {
   FaultsSection f_;
   std::mt19937_64 rng_;
   std::optional<double> stuck_;  // the stuck wheel's frozen reading
+  std::vector<world::Block> object_;
+  std::vector<int> recoloured_;  // sorted cone indices
 };
 
 }  // namespace paddock::runner

@@ -52,14 +52,16 @@ Pose2 PoseHistory::at(TimeNs t) const {
   return p;
 }
 
-void RawSensors::update_scene(const world::ConeWorld& cones) {
+void RawSensors::update_scene(const world::ConeWorld& cones, const FaultInjector& faults, double t) {
   const auto n = static_cast<std::size_t>(cones.cone_count());
-  bool changed = world_ == nullptr || scene_cones_.size() != n;
+  const std::vector<world::Block>& objects = faults.objects(t);
+  bool changed = world_ == nullptr || scene_cones_.size() != n || objects.size() != scene_objects_;
   if (!changed) {
     for (std::size_t i = 0; i < n && !changed; ++i) {
       const int ii = static_cast<int>(i);
       changed = cones.cone_knocked(ii) != scene_knocked_[i] ||
-                distance(cones.cone_position(ii), scene_cones_[i].position) > 0.01;
+                distance(cones.cone_position(ii), scene_cones_[i].position) > 0.01 ||
+                faults.colour(ii, cones.cone(ii).color, t) != scene_cones_[i].color;
     }
   }
   if (!changed) return;
@@ -67,16 +69,19 @@ void RawSensors::update_scene(const world::ConeWorld& cones) {
   scene_knocked_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const int ii = static_cast<int>(i);
-    scene_cones_[i] = {cones.cone_position(ii), cones.cone(ii).color};
+    scene_cones_[i] = {cones.cone_position(ii), faults.colour(ii, cones.cone(ii).color, t)};
     scene_knocked_[i] = cones.cone_knocked(ii);
   }
+  std::vector<world::Block> blocks = blocks_;
+  blocks.insert(blocks.end(), objects.begin(), objects.end());
+  scene_objects_ = objects.size();
   world_.reset();  // one Embree device at a time
-  world_ = std::make_unique<sensors::LidarWorld>(scene_cones_, scene_knocked_, ground_, blocks_);
+  world_ = std::make_unique<sensors::LidarWorld>(scene_cones_, scene_knocked_, ground_, blocks);
 }
 
 const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,
-                                                  SimHal& hal, const FaultInjector& faults, double t) {
-  update_scene(cones);
+                                                  SimHal& hal, FaultInjector& faults, double t) {
+  update_scene(cones, faults, t);
   const TimeNs start = now - lidar_.period_ns();
   if (camera_ && !faults.camera_dead(t)) {
     const TimeNs exposure = sensors::trigger_time(lidar_.params(), camera_->params().trigger_azimuth, start);

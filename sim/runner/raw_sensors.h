@@ -68,14 +68,16 @@ class RawSensors {
   // faults: the LiDAR's and the camera's at t (s, now): a rotation not sent,
   // returns lost, a dead or frozen camera
   const std::vector<std::int32_t>& emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,
-                                        SimHal& hal, const FaultInjector& faults, double t);
+                                        SimHal& hal, FaultInjector& faults, double t);
   // the stamp of the scan's last column (the scan's `end`) for a rotation ending at `now`
   TimeNs scan_end(TimeNs now) const;
   // the last camera frame rendered (for the perception figures), or null
   const hal::CameraFrame* camera_frame() const { return camera_ && frame_.width > 0 ? &frame_ : nullptr; }
 
  private:
-  void update_scene(const world::ConeWorld& cones);
+  // the cones as they stand (in the colours the faults give them at t) and
+  // the blocks (the venue's and a fault's object): rebuilt when they changed
+  void update_scene(const world::ConeWorld& cones, const FaultInjector& faults, double t);
 
   sensors::Lidar lidar_;
   std::unique_ptr<sensors::Camera> camera_;
@@ -85,6 +87,7 @@ class RawSensors {
   sensors::CameraAnnotation annotation_;
   sensors::GroundParams ground_;
   std::vector<world::Block> blocks_;
+  std::size_t scene_objects_ = 0;  // a fault's object blocks in the scene
   std::unique_ptr<sensors::LidarWorld> world_;
   std::vector<Cone> scene_cones_;
   std::vector<bool> scene_knocked_;

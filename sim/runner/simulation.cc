@@ -13,7 +13,7 @@ namespace {
 void measure_cones(SimState& s, const Pose2& base) {
   for (int i = 0; i < s.cones.cone_count(); ++i) {
     const auto u = static_cast<std::size_t>(i);
-    s.cones_now[u] = {s.cones.cone_position(i), s.cones.cone(i).color};
+    s.cones_now[u] = {s.cones.cone_position(i), s.faults.colour(i, s.cones.cone(i).color, s.t)};
     s.cones_knocked[u] = s.cones.cone_knocked(i);
   }
   s.in_flight.emplace_back(s.now + s.cone_sensor.latency_ns(), s.cone_sensor.measure(s.cones_now, s.cones_knocked, base, s.now));
@@ -251,6 +251,7 @@ SimState::SimState(const SimModel& model, WireTap* tap)
       steering(model.scenario.steering_sensor, stream_seed(model.scenario.scenario.seed, "steering_sensor")),
       true_poses(model.pose_history_span) {
   hal.set_tap(tap);
+  faults.place(model.track, model.cones);
   run_due(model, *this);
 }
 
@@ -259,7 +260,14 @@ void step(const SimModel& model, SimState& s) {
   const vehicle::VehicleParams& car = model.scenario.vehicle;
   const double nose_x = model.footprint.x_max;
   const Vec2 nose0 = vehicle::base_pose(car, s.car).transform({nose_x, 0.0});
-  vehicle::step(car, s.car, s.input, model.dt);
+  // in the rain ([faults.rain]) the tyres grip less
+  const double grip = s.faults.grip(s.t);
+  if (grip < 1.0 && !s.wet) {
+    s.wet = car;
+    s.wet->tyre_d *= grip;
+    s.wet->tyre_dx *= grip;
+  }
+  vehicle::step(grip < 1.0 ? *s.wet : car, s.car, s.input, model.dt);
   if (!vehicle::is_finite(s.car)) {
     // a state that is no number cannot be stepped, sensed or timed: the run
     // ends here, with its reason; nothing falls due at this instant

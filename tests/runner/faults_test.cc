@@ -124,5 +124,58 @@ TEST(Faults, TheImuStepAddsItsBiasAndTheNotesNameEveryFault) {
   EXPECT_EQ(notes[2].at, 10.0);
 }
 
+TEST(Faults, TheObjectStandsBesideTheBoundaryAndTheColoursSwapOnTime) {
+  // a straight 3 m wide track along +x, centreline every 0.5 m
+  world::TrackModel track;
+  for (int i = 0; i <= 200; ++i) {
+    track.centreline.push_back({0.5 * i, 0.0});
+    track.width.push_back(3.0);
+  }
+  std::vector<Cone> cones;
+  for (int i = 0; i < 20; ++i) {
+    cones.push_back({{5.0 * i, 1.5}, ConeColor::Blue});
+    cones.push_back({{5.0 * i, -1.5}, ConeColor::Yellow});
+  }
+  cones.push_back({{0.0, 3.0}, ConeColor::BigOrange});
+  FaultsSection f;
+  f.object.at = 2.0;
+  f.object.kind = ObjectKind::Bag;
+  f.object.along = 30.0;
+  f.object.edge_offset = 0.5;
+  f.object.left = false;
+  f.cones.at = 1.0;
+  f.cones.wrong_colour = 5;
+  FaultInjector inj(f, 3);
+  inj.place(track, cones);
+  EXPECT_TRUE(inj.objects(1.9).empty());
+  ASSERT_EQ(inj.objects(2.0).size(), 1u);
+  const world::Block& b = inj.objects(2.0)[0];
+  EXPECT_NEAR(b.centre.x, 30.0, 0.5);   // within one centreline step of 30 m
+  EXPECT_NEAR(b.centre.y, -2.0, 1e-9);  // 1.5 m half width + 0.5 m, on the right
+  int swapped = 0;
+  for (int i = 0; i < static_cast<int>(cones.size()); ++i) {
+    const ConeColor before = inj.colour(i, cones[static_cast<std::size_t>(i)].color, 0.5);
+    const ConeColor after = inj.colour(i, cones[static_cast<std::size_t>(i)].color, 1.5);
+    EXPECT_EQ(before, cones[static_cast<std::size_t>(i)].color);
+    if (after != before) {
+      ++swapped;
+      EXPECT_EQ(after, before == ConeColor::Blue ? ConeColor::Yellow : ConeColor::Blue);
+    }
+  }
+  EXPECT_EQ(swapped, 5);
+  EXPECT_EQ(inj.colour(40, ConeColor::BigOrange, 1.5), ConeColor::BigOrange);
+  // the rain: the returns lost in the asked share
+  FaultsSection r;
+  r.rain.at = 0.0;
+  r.rain.returns_lost = 0.25;
+  FaultInjector rain(r, 5);
+  std::vector<sensors::LidarPoint> pts = ring_of_points();
+  rain.filter_lidar(1.0, pts);
+  const double n = 32.0 * 360.0;
+  EXPECT_NEAR(static_cast<double>(pts.size()), 0.75 * n, 4.5 * std::sqrt(n * 0.25 * 0.75));
+  EXPECT_EQ(rain.grip(1.0), r.rain.grip);
+  EXPECT_EQ(FaultInjector(FaultsSection{}, 5).grip(1.0), 1.0);
+}
+
 }  // namespace
 }  // namespace paddock::runner

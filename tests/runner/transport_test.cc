@@ -99,7 +99,7 @@ TEST(Transport, TheWireGivesTheStackTheLidarScansBitForBit) {
     poses.record(now, Pose2{model.start.x + 25.0 * (std::sin(yaw) - std::sin(model.start.yaw)),
                             model.start.y - 25.0 * (std::cos(yaw) - std::cos(model.start.yaw)), yaw});
     if (!mem_raw.rotation_ends(now)) continue;
-    const FaultInjector none(FaultsSection{}, 0);
+    FaultInjector none(FaultsSection{}, 0);
     const std::vector<std::int32_t> truth_mem = mem_raw.emit(now, cones, poses, mem, none, to_seconds(now));
     const std::vector<std::int32_t> truth_wire = wire_raw.emit(now, cones, poses, wire, none, to_seconds(now));
     EXPECT_EQ(truth_mem, truth_wire);
