@@ -1,7 +1,9 @@
 #include "sim/runner/cli.h"
 
 #include <signal.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cmath>
@@ -125,6 +127,27 @@ int option_int(const std::string& flag, const std::string& v, int lo, int hi) {
   return static_cast<int>(x);
 }
 
+
+// Ctrl-C (or a kill) during a run: the process ends at once, 128 + the signal,
+// saying that the output folder is marked incomplete (the marker stays)
+char g_interrupt_message[1024];
+std::size_t g_interrupt_length = 0;
+extern "C" void on_run_interrupt(int sig) {
+  const ssize_t w = ::write(2, g_interrupt_message, g_interrupt_length);
+  (void)w;
+  ::_exit(128 + sig);
+}
+void announce_interrupts(const std::string& marker) {
+  const std::string m = "paddock: interrupted; " + marker + " marks the run's folder incomplete\n";
+  g_interrupt_length = std::min(m.size(), sizeof g_interrupt_message);
+  std::copy(m.begin(), m.begin() + static_cast<std::ptrdiff_t>(g_interrupt_length), g_interrupt_message);
+  struct sigaction sa {};
+  sa.sa_handler = on_run_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+}
+
 // takes a plot option at args[i] (and its value); false when args[i] is not one
 bool plot_option(const std::vector<std::string>& args, std::size_t& i, PlotOptions& o) {
   const std::string& a = args[i];
@@ -174,6 +197,10 @@ int cmd_run(const std::vector<std::string>& args) {
   const world::TrackModel track = load_track(scenario.track_path, &warnings);
   for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
   if (out_dir.empty()) out_dir = (std::filesystem::path("runs") / scenario.name).string();
+  // DIR/INCOMPLETE until every result is in place (and the folder's
+  // writability checked before the work); Ctrl-C leaves it, and says so
+  IncompleteMarker marker(out_dir, "paddock run " + scenario_path + " started here");
+  announce_interrupts(marker.path());
 
   // --log: DIR/run.mcap, written beside the run and put in place at its end
   std::unique_ptr<RunLog> run_log;
@@ -211,6 +238,7 @@ int cmd_run(const std::vector<std::string>& args) {
 
   std::vector<std::string> figures;
   if (plots) figures = plot_run(out_dir, plot_options);
+  marker.done();
 
   if (json) {
     std::cout << js;

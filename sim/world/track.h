@@ -38,6 +38,10 @@ struct DoubledCone {
 };
 
 inline constexpr double kDoubledConeDistance = 0.05;  // m
+// the most cones a track file may hold: a Formula Student track has a few
+// hundred; a file of millions is no track, and checking it for doubled cones
+// would take hours
+inline constexpr std::size_t kMaxTrackCones = 10000;
 
 // the content of one track file, as written
 struct TrackFile {
@@ -52,7 +56,9 @@ struct TrackFile {
   std::vector<std::string> warnings;    // "source:line: ..." (doubled cones)
 };
 
-// parse the text of a track file; `source` names it in messages. Throws TrackError.
+// parse the text of a track file; `source` names it in messages. Throws
+// TrackError (also for a file of more than kMaxTrackCones cones, at its first
+// cone too many).
 TrackFile parse_track(std::string_view text, const std::string& source);
 
 enum class TrackKind { Circuit, Acceleration, Skidpad };

@@ -166,6 +166,10 @@ TrackFile parse_track(std::string_view text, const std::string& source) {
     if (!color) {
       fail(source, line, "unknown cone tag '" + std::string(tag) + "', expected one of " + std::string(kTagList));
     }
+    if (f.cones.size() == kMaxTrackCones) {
+      fail(source, line, "more than " + std::to_string(kMaxTrackCones) +
+                             " cones: a Formula Student track has a few hundred; refused");
+    }
     Cone c;
     c.color = *color;
     c.position.x = parse_number(cols[1], source, line, "x");
