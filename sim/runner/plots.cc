@@ -15,41 +15,13 @@
 #include "sim/runner/scenario.h"
 #include "sim/vehicle/vehicle.h"
 #include "sim/world/track.h"
+#include "sim/runner/summary_reader.h"
 #include "sim/world/venue.h"
 
 namespace paddock::runner {
 namespace {
 
-// the laps of summary.json, as far as the lap chart and the lap markers need them
-struct SummaryLaps {
-  std::vector<double> start, time;
-  std::vector<bool> timed;
-  std::vector<int> doo, oc;
-  double total_time = 0.0;
-  bool finished = false;
-  std::string scenario;  // the scenario's name
-};
-
-SummaryLaps read_summary(const std::string& path) {
-  const std::string text = read_file(path);
-  SummaryLaps s;
-  try {
-    const nlohmann::json j = nlohmann::json::parse(text);
-    for (const auto& lap : j.at("laps")) {
-      s.start.push_back(lap.at("start").get<double>());
-      s.time.push_back(lap.at("time").get<double>());
-      s.timed.push_back(lap.at("timed").get<bool>());
-      s.doo.push_back(lap.at("doo").get<int>());
-      s.oc.push_back(lap.at("oc").get<int>());
-    }
-    s.total_time = j.at("total_time").get<double>();
-    s.finished = j.at("finished").get<bool>();
-    s.scenario = j.at("scenario").get<std::string>();
-  } catch (const nlohmann::json::exception& e) {
-    throw UserError(path + ": not a paddock summary: " + e.what());
-  }
-  return s;
-}
+SummaryLaps read_summary(const std::string& path) { return parse_summary(read_file(path), path); }
 
 // the layers of DIR/plan.json, when the run planned from cones
 void add_plan_layers(const std::string& path, render::TrackMapData& map) {
