@@ -54,23 +54,27 @@ void Health::camera(TimeNs now, const hal::CameraDetections& d, double speed) {
   frozen_ = same_boxes_ + 1 >= p_.camera_frozen_frames;
 }
 
-void Health::lidar_mode(TimeNs now, bool bad, double speed, const std::string& why) {
+void Health::slow_mode(Slow& m, TimeNs now, bool bad, double speed, const std::string& why) {
   if (bad) {
-    lidar_healthy_since_.reset();
-    if (lidar_degraded_) return;
-    lidar_degraded_ = now;
-    degraded_from_speed_ = speed;
-    lidar_reason_ = why;
-    note(now, "degraded: " + why + ": driving on the map and odometry at reduced speed");
+    m.healthy_since.reset();
+    if (m.since) return;
+    m.since = now;
+    m.from_speed = speed;
+    note(now, "degraded: " + why);
     return;
   }
-  if (!lidar_degraded_) return;
-  if (!lidar_healthy_since_) lidar_healthy_since_ = now;
-  if (now - *lidar_healthy_since_ >= from_seconds(p_.recover_time)) {
-    note(now, "recovered: LiDAR healthy for " + secs(now - *lidar_healthy_since_) + ": full speed");
-    lidar_degraded_.reset();
-    lidar_healthy_since_.reset();
+  if (!m.since) return;
+  if (!m.healthy_since) m.healthy_since = now;
+  if (now - *m.healthy_since >= from_seconds(p_.recover_time)) {
+    note(now, std::string("recovered: ") + m.name + " healthy for " + secs(now - *m.healthy_since) + ": full speed");
+    m.since.reset();
+    m.healthy_since.reset();
   }
+}
+
+double Health::cap(const Slow& m, TimeNs now) const {
+  if (!m.since) return std::numeric_limits<double>::infinity();
+  return std::max(p_.degraded_speed, m.from_speed - p_.degraded_decel * to_seconds(now - *m.since));
 }
 
 void Health::cycle(TimeNs now, double speed) {
@@ -97,7 +101,11 @@ void Health::cycle(TimeNs now, double speed) {
       std::snprintf(why, sizeof why, "LiDAR scans sparse (under %.0f %% of the usual %.0f points)", 100.0 * p_.lidar_sparse,
                     usual_points_);
     }
-    lidar_mode(now, lost || sparse_, speed, why);
+    slow_mode(lidar_, now, lost || sparse_, speed, std::string(why) + ": driving on the map and odometry at reduced speed");
+  }
+  if (map_lost_ >= p_.map_lost_frames || map_.since) {
+    slow_mode(map_, now, map_lost_ >= p_.map_lost_frames, speed,
+              "map inconsistent (SLAM lost " + std::to_string(map_lost_) + " frames in a row): reduced speed");
   }
   if (use_camera_ && last_camera_) {
     const bool lost = now - *last_camera_ > from_seconds(p_.camera_lost);
@@ -121,9 +129,6 @@ void Health::cycle(TimeNs now, double speed) {
   }
 }
 
-double Health::speed_cap(TimeNs now) const {
-  if (!lidar_degraded_) return std::numeric_limits<double>::infinity();
-  return std::max(p_.degraded_speed, degraded_from_speed_ - p_.degraded_decel * to_seconds(now - *lidar_degraded_));
-}
+double Health::speed_cap(TimeNs now) const { return std::min(cap(lidar_, now), cap(map_, now)); }
 
 }  // namespace paddock::stack

@@ -10,6 +10,9 @@
 //   camera silent (lidar_camera)     -> LiDAR-only colour
 //   camera frozen (the same boxes    -> LiDAR-only colour (the stale boxes
 //   frame after frame while moving)     would drop true cones and recolour them)
+//   the map inconsistent (SLAM's     -> degraded: reduced speed until the
+//   front end lost map_lost_frames      frames fit the map again
+//   frames in a row)
 //   IMU or wheel speeds silent       -> fault (AS Emergency): the estimate has
 //   (slam != ground_truth)              nothing to dead-reckon on
 //   the control cycle late by        -> fault (AS Emergency)
@@ -40,6 +43,7 @@ struct HealthParams {
   double degraded_speed = 5.0;
   double degraded_decel = 4.0;
   double recover_time = 0.5;
+  int map_lost_frames = 2;
 
   template <class V>
   void visit(V& v) {
@@ -53,6 +57,7 @@ struct HealthParams {
     v(PADDOCK_PARAM(degraded_speed), {"m/s", params::in(0.0, 100.0), "the speed cap of degraded driving"});
     v(PADDOCK_PARAM(degraded_decel), {"m/s^2", params::in(0.1, 50.0), "the cap ramps down to it at this rate"});
     v(PADDOCK_PARAM(recover_time), {"s", params::in(0.0, 60.0), "an input healthy this long again ends its degraded mode"});
+    v(PADDOCK_PARAM(map_lost_frames), {"", params::in(1, 1000), "SLAM lost this many frames in a row: the map is inconsistent, degraded (reduced speed)"});
   }
   std::string check() const {
     return lidar_timeout < lidar_lost ? "lidar_timeout must be at least lidar_lost" : "";
@@ -77,6 +82,8 @@ class Health {
   void camera(TimeNs now, const hal::CameraDetections& d, double speed);
   void imu(TimeNs now) { last_imu_ = now; }
   void wheels(TimeNs now) { last_wheels_ = now; }
+  // SLAM's front end: how many frames in a row it was lost (0: the last fit the map)
+  void map_fit(int lost_run) { map_lost_ = lost_run; }
 
   // the control cycle at now, at speed (m/s): the watchdogs, the modes
   void cycle(TimeNs now, double speed);
@@ -85,7 +92,8 @@ class Health {
   const std::string& fault() const { return fault_; }
   // driving degraded (LiDAR lost or sparse): the speed cap now (m/s); +inf otherwise
   double speed_cap(TimeNs now) const;
-  bool lidar_degraded() const { return lidar_degraded_.has_value(); }
+  bool lidar_degraded() const { return lidar_.since.has_value(); }
+  bool map_degraded() const { return map_.since.has_value(); }
   // the camera's boxes are not to be trusted (lost or frozen)
   bool camera_distrusted() const { return camera_out_; }
   const std::vector<HealthEvent>& events() const { return events_; }
@@ -93,7 +101,15 @@ class Health {
  private:
   void note(TimeNs now, std::string what) { events_.push_back({now, std::move(what)}); }
   void set_fault(TimeNs now, const std::string& why);
-  void lidar_mode(TimeNs now, bool bad, double speed, const std::string& why);
+  // a degraded mode of reduced speed: since when, from what speed, healthy again since
+  struct Slow {
+    const char* name;
+    std::optional<TimeNs> since;
+    double from_speed = 0.0;
+    std::optional<TimeNs> healthy_since;
+  };
+  void slow_mode(Slow& m, TimeNs now, bool bad, double speed, const std::string& why);
+  double cap(const Slow& m, TimeNs now) const;
 
   HealthParams p_;
   bool use_lidar_, use_camera_, use_odometry_;
@@ -102,11 +118,9 @@ class Health {
   double usual_points_ = 0.0;
   int scans_seen_ = 0;
   bool sparse_ = false;
-  // LiDAR degraded: since when, at what speed; healthy again since
-  std::optional<TimeNs> lidar_degraded_;
-  double degraded_from_speed_ = 0.0;
-  std::optional<TimeNs> lidar_healthy_since_;
-  std::string lidar_reason_;
+  Slow lidar_{"LiDAR", {}, 0.0, {}};
+  Slow map_{"map", {}, 0.0, {}};
+  int map_lost_ = 0;
   // camera: frozen boxes counted, out of use
   std::vector<hal::CameraBox> last_boxes_;
   int same_boxes_ = 0;

@@ -158,6 +158,9 @@ class Localisation {
   // SLAM's map: the confirmed landmarks of the highest-weight particle
   std::vector<slam::MappedCone> map() const;
   const LocalisationStats& stats() const { return stats_; }
+  // frames in a row in which the front end associated too little: the
+  // frames and the map disagree (0: the last frame fit)
+  int lost_run() const { return lost_run_; }
   // var(x) + var(y) of the estimate (m^2): the EKF's (odometry); SLAM's
   // particle spread at the last frame plus what the odometry added since
   double position_variance() const;

@@ -446,6 +446,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   now_ = now;
   while (auto m = hal.receive()) on_message(std::move(*m));
   // the watchdogs and the degraded modes (health.h); a fault it cannot drive with ends in AS Emergency
+  if (localisation_ && localisation_->owns_map()) health_.map_fit(localisation_->lost_run());
   health_.cycle(now, state_ ? std::hypot(state_->vx, state_->vy) : 0.0);
   if (!health_.fault().empty() && fault_.empty()) emergency(health_.fault());
   if (perception_) perception_->set_camera_distrusted(health_.camera_distrusted());

@@ -119,6 +119,26 @@ TEST(Health, ACameraLostOrFrozenIsDistrustedAndTrustedAgain) {
   EXPECT_TRUE(noted(frozen, "recovered: camera"));
 }
 
+TEST(Health, AnInconsistentMapSlowsTheCarUntilTheFramesFitAgain) {
+  Health h(HealthParams{}, false, false, true);
+  drive(h, 0, 1000 * kMs, 0, 12.0, false);
+  h.map_fit(1);  // one frame lost: not yet
+  drive(h, 1000 * kMs, 1100 * kMs, 0, 12.0, false);
+  EXPECT_FALSE(h.map_degraded());
+  h.map_fit(2);
+  drive(h, 1100 * kMs, 1110 * kMs, 0, 12.0, false);
+  EXPECT_TRUE(h.map_degraded());
+  EXPECT_TRUE(noted(h, "map inconsistent (SLAM lost 2 frames in a row)"));
+  EXPECT_NEAR(h.speed_cap(1600 * kMs), 10.0, 1e-9);  // from 12 m/s at 4 m/s^2
+  h.map_fit(0);
+  drive(h, 1110 * kMs, 1600 * kMs, 0, 12.0, false);
+  EXPECT_TRUE(h.map_degraded());
+  drive(h, 1600 * kMs, 1700 * kMs, 0, 12.0, false);
+  EXPECT_FALSE(h.map_degraded());
+  EXPECT_TRUE(noted(h, "recovered: map healthy"));
+  EXPECT_TRUE(h.fault().empty());
+}
+
 TEST(Health, SilentOdometryAndALateCycleAreFaults) {
   Health imu(HealthParams{}, false, false, true);
   for (TimeNs t = 0; t <= 500 * kMs; t += 10 * kMs) {
