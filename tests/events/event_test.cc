@@ -175,6 +175,41 @@ TEST(Event, TimeoutAndStallAreDnfs) {
   EXPECT_FALSE(stalled.result().finished);
 }
 
+TEST(Event, AnEmergencyEndsTheRunOnceTheCarIsAtRestWithItsConesCounted) {
+  const auto track = strip_track();
+  Event e(EventKind::Autocross, track, EventParams{});
+  e.start(0.0);
+  cross(e, 5.0);
+  CarSample s = sample(10.0, {40.0, 0.0}, 12.0);
+  s.as_emergency = true;
+  e.on_sample(s);
+  EXPECT_FALSE(e.done());  // still rolling: the EBS brakes it
+  s = sample(10.5, {44.0, 0.0}, 3.0, false, 1);
+  s.as_emergency = true;
+  e.on_sample(s);
+  EXPECT_FALSE(e.done());
+  s = sample(11.0, {45.0, 0.0}, 0.0, false, 1);
+  s.as_emergency = true;
+  e.on_sample(s);
+  ASSERT_TRUE(e.done());
+  EXPECT_FALSE(e.result().finished);
+  EXPECT_EQ(e.result().dnf_reason, "the car went to AS Emergency");
+  EXPECT_EQ(e.result().doo, 1);  // the cone hit while braking counts
+  EXPECT_EQ(e.result().finish_time, 11.0);
+}
+
+TEST(Event, ACarThatNeverHoldsAsReadyIsADnfAfterTheReadyTimeout) {
+  EventParams p;
+  p.ready_timeout = 30.0;
+  const auto track = strip_track();
+  Event e(EventKind::Autocross, track, p);
+  for (double t = 0.0; t <= 30.0; t += 0.5) e.on_sample(sample(t, {-1.0, 0.0}, 0.0));
+  EXPECT_FALSE(e.done());
+  e.on_sample(sample(30.01, {-1.0, 0.0}, 0.0));
+  ASSERT_TRUE(e.done());
+  EXPECT_EQ(e.result().dnf_reason, "no go: the car did not hold AS Ready long enough within 30 s");
+}
+
 TEST(Event, SkidpadScoresTheMeanOfTheTimedLapsAndCheapCones) {
   const auto track = strip_track();
   Event e(EventKind::Skidpad, track, EventParams{});
