@@ -46,6 +46,18 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
   std::map<std::string, std::string> files;
   try {
     reader.open();
+    // a log of any size replays in bounded memory: its messages chunk by
+    // chunk, so no attachment or chunk may be larger than an input may be
+    for (const log::AttachmentIndex& a : reader.attachment_indexes()) {
+      if (a.data_size > kMaxInputBytes)
+        throw UserError(path + ": attachment " + a.name + " of " + std::to_string(a.data_size) + " bytes, more than the " +
+                        std::to_string(kMaxInputBytes) + " a replay reads: refused");
+    }
+    for (const log::ChunkIndex& c : reader.chunk_indexes()) {
+      if (c.uncompressed_size > kMaxInputBytes)
+        throw UserError(path + ": a chunk of " + std::to_string(c.uncompressed_size) + " bytes, more than the " +
+                        std::to_string(kMaxInputBytes) + " a replay holds at once: refused");
+    }
     for (const log::Attachment& a : reader.read_attachments()) files[a.name] = text_of(a.data);
   } catch (const log::McapError& e) {
     throw UserError(path + ": " + e.what());
