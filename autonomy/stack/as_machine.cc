@@ -1,17 +1,14 @@
 #include "autonomy/stack/as_machine.h"
 
-#include <cstdio>
 #include <utility>
+
+#include "autonomy/common/format.h"
 
 namespace paddock::stack {
 
 namespace {
 
-std::string bar(double p) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.1f bar", p);
-  return b;
-}
+std::string bar(double p) { return fixed(p, 1) + " bar"; }
 
 }  // namespace
 
@@ -71,10 +68,8 @@ void AsMachine::step(TimeNs now, const AsInputs& in) {
         if (ready_for >= from_seconds(params_.ready_wait)) {
           enter(now, AsState::Driving, "go");
         } else {
-          char b[128];
-          std::snprintf(b, sizeof b, "go ignored at %.3f s: %.3f s in AS Ready, the rules ask for %.3f s", to_seconds(now),
-                        to_seconds(ready_for), params_.ready_wait);
-          ignored_go_ = b;
+          ignored_go_ = "go ignored at " + fixed(to_seconds(now), 3) + " s: " + fixed(to_seconds(ready_for), 3) +
+                        " s in AS Ready, the rules ask for " + fixed(params_.ready_wait, 3) + " s";
         }
       } else if (driving && in.mission_done) {
         enter(now, AsState::Finished, "mission over, at rest");

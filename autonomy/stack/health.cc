@@ -1,18 +1,15 @@
 #include "autonomy/stack/health.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <limits>
+
+#include "autonomy/common/format.h"
 
 namespace paddock::stack {
 
 namespace {
 
-std::string secs(TimeNs d) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3f s", to_seconds(d));
-  return b;
-}
+std::string secs(TimeNs d) { return fixed(to_seconds(d), 3) + " s"; }
 
 bool same_boxes(const std::vector<hal::CameraBox>& a, const std::vector<hal::CameraBox>& b) {
   if (a.empty() || a.size() != b.size()) return false;
@@ -54,13 +51,14 @@ void Health::camera(TimeNs now, const hal::CameraDetections& d, double speed) {
   frozen_ = same_boxes_ + 1 >= p_.camera_frozen_frames;
 }
 
-void Health::slow_mode(Slow& m, TimeNs now, bool bad, double speed, const std::string& why) {
+template <class Why>
+void Health::slow_mode(Slow& m, TimeNs now, bool bad, double speed, const Why& why) {
   if (bad) {
     m.healthy_since.reset();
     if (m.since) return;
     m.since = now;
     m.from_speed = speed;
-    note(now, "degraded: " + why);
+    note(now, "degraded: " + why());
     return;
   }
   if (!m.since) return;
@@ -94,18 +92,18 @@ void Health::cycle(TimeNs now, double speed) {
     if (silent > from_seconds(p_.lidar_timeout))
       set_fault(now, "no LiDAR scan for " + secs(silent) + " (limit " + secs(from_seconds(p_.lidar_timeout)) + ")");
     const bool lost = silent > from_seconds(p_.lidar_lost);
-    char why[128];
-    if (lost) {
-      std::snprintf(why, sizeof why, "LiDAR lost (no scan for %.3f s)", to_seconds(silent));
-    } else {
-      std::snprintf(why, sizeof why, "LiDAR scans sparse (under %.0f %% of the usual %.0f points)", 100.0 * p_.lidar_sparse,
-                    usual_points_);
-    }
-    slow_mode(lidar_, now, lost || sparse_, speed, std::string(why) + ": driving on the map and odometry at reduced speed");
+    // the reason is built only when the mode is entered
+    slow_mode(lidar_, now, lost || sparse_, speed, [&] {
+      return (lost ? "LiDAR lost (no scan for " + secs(silent) + ")"
+                   : "LiDAR scans sparse (under " + fixed(100.0 * p_.lidar_sparse, 0) + " % of the usual " +
+                         fixed(usual_points_, 0) + " points)") +
+             ": driving on the map and odometry at reduced speed";
+    });
   }
   if (map_lost_ >= p_.map_lost_frames || map_.since) {
-    slow_mode(map_, now, map_lost_ >= p_.map_lost_frames, speed,
-              "map inconsistent (SLAM lost " + std::to_string(map_lost_) + " frames in a row): reduced speed");
+    slow_mode(map_, now, map_lost_ >= p_.map_lost_frames, speed, [&] {
+      return "map inconsistent (SLAM lost " + std::to_string(map_lost_) + " frames in a row): reduced speed";
+    });
   }
   if (use_camera_ && last_camera_) {
     const bool lost = now - *last_camera_ > from_seconds(p_.camera_lost);

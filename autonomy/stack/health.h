@@ -108,7 +108,9 @@ class Health {
     double from_speed = 0.0;
     std::optional<TimeNs> healthy_since;
   };
-  void slow_mode(Slow& m, TimeNs now, bool bad, double speed, const std::string& why);
+  // enters or leaves the slow mode m; why() gives the reason when it is entered
+  template <class Why>
+  void slow_mode(Slow& m, TimeNs now, bool bad, double speed, const Why& why);
   double cap(const Slow& m, TimeNs now) const;
 
   HealthParams p_;

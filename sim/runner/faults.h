@@ -38,11 +38,13 @@ struct FaultWindow {
   std::optional<double> at;
   double duration = 0.0;
   bool on(double t) const { return at && t >= *at && (duration <= 0.0 || t < *at + duration); }
+  // the window's two keys; at_doc says what begins at `at`
+  template <class V>
+  void visit_window(V& v, const char* at_doc) {
+    v(PADDOCK_PARAM(at), {"s", params::at_least(0.0), at_doc});
+    v(PADDOCK_PARAM(duration), {"s", params::at_least(0.0), "how long it lasts (0: to the end of the run)"});
+  }
 };
-
-#define PADDOCK_FAULT_WINDOW(v, what)                                                                         \
-  v(PADDOCK_PARAM(at), {"s", params::at_least(0.0), "sim time the " what " begins (unset: no such fault)"}); \
-  v(PADDOCK_PARAM(duration), {"s", params::at_least(0.0), "how long it lasts (0: to the end of the run)"})
 
 enum class LidarDropout { Rotations, Sector, Rings };
 struct LidarFault : FaultWindow {
@@ -56,7 +58,7 @@ struct LidarFault : FaultWindow {
       {"rotations", LidarDropout::Rotations}, {"sector", LidarDropout::Sector}, {"rings", LidarDropout::Rings}};
   template <class V>
   void visit(V& v) {
-    PADDOCK_FAULT_WINDOW(v, "LiDAR dropout");
+    visit_window(v, "sim time the LiDAR dropout begins (unset: no such fault)");
     v(PADDOCK_PARAM(mode), kModes, "rotations: no packets at all; sector: no returns in [sector_from, sector_to]; rings: none from rings ring_first..ring_last");
     v(PADDOCK_PARAM(sector_from), {"rad", params::in(-3.1416, 3.1416), "mode = sector: the sector's first azimuth (0 ahead, > 0 left)"});
     v(PADDOCK_PARAM(sector_to), {"rad", params::in(-3.1416, 3.1416), "mode = sector: its last azimuth (counter-clockwise from sector_from)"});
@@ -73,7 +75,7 @@ struct CameraFault : FaultWindow {
                                                                {"frozen", CameraFaultMode::Frozen}};
   template <class V>
   void visit(V& v) {
-    PADDOCK_FAULT_WINDOW(v, "camera fault");
+    visit_window(v, "sim time the camera fault begins (unset: no such fault)");
     v(PADDOCK_PARAM(mode), kModes, "dead: no frames, so no detections; frozen: the last image again, newly stamped");
   }
 };
@@ -87,7 +89,7 @@ struct ImuFault : FaultWindow {
   double spike_yaw_rate = 0.0; // rad/s, on the yaw rate
   template <class V>
   void visit(V& v) {
-    PADDOCK_FAULT_WINDOW(v, "IMU fault");
+    visit_window(v, "sim time the IMU fault begins (unset: no such fault)");
     v(PADDOCK_PARAM(bias_ax), {"m/s^2", params::in(-50.0, 50.0), "a step on the forward accelerometer's bias"});
     v(PADDOCK_PARAM(bias_ay), {"m/s^2", params::in(-50.0, 50.0), "a step on the lateral accelerometer's bias"});
     v(PADDOCK_PARAM(bias_yaw_rate), {"rad/s", params::in(-5.0, 5.0), "a step on the gyro's yaw-rate bias"});
@@ -106,7 +108,7 @@ struct WheelFault : FaultWindow {
                                                               {"noisy", WheelFaultMode::Noisy}};
   template <class V>
   void visit(V& v) {
-    PADDOCK_FAULT_WINDOW(v, "wheel-speed fault");
+    visit_window(v, "sim time the wheel-speed fault begins (unset: no such fault)");
     v(PADDOCK_PARAM(wheel), {"", params::in(0, 3), "the sensor: 0 front left, 1 front right, 2 rear left, 3 rear right"});
     v(PADDOCK_PARAM(mode), kModes, "stuck: it repeats its last reading; noisy: white noise added");
     v(PADDOCK_PARAM(noise), {"rad/s", params::in(0.0, 1000.0), "mode = noisy: the noise's standard deviation"});
@@ -121,7 +123,7 @@ struct SteeringFault : FaultWindow {
                                                                  {"actuator", SteeringFaultMode::Actuator}};
   template <class V>
   void visit(V& v) {
-    PADDOCK_FAULT_WINDOW(v, "steering offset");
+    visit_window(v, "sim time the steering offset begins (unset: no such fault)");
     v(PADDOCK_PARAM(mode), kModes, "sensor: the measured angle is off; actuator: the road wheels are off the request (the sensor reads them true)");
     v(PADDOCK_PARAM(offset), {"rad", params::in(-0.5, 0.5), "the offset, > 0 left"});
   }
@@ -130,7 +132,7 @@ struct SteeringFault : FaultWindow {
 struct ControlFault : FaultWindow {
   template <class V>
   void visit(V& v) {
-    PADDOCK_FAULT_WINDOW(v, "stall of the stack's computer (no control cycle)");
+    visit_window(v, "sim time the stall of the stack's computer (no control cycle) begins (unset: no such fault)");
   }
 };
 
@@ -138,7 +140,7 @@ struct CanFault : FaultWindow {
   double loss = 0.5;  // share of the VCU's frames lost
   template <class V>
   void visit(V& v) {
-    PADDOCK_FAULT_WINDOW(v, "CAN frame loss");
+    visit_window(v, "sim time the CAN frame loss begins (unset: no such fault)");
     v(PADDOCK_PARAM(loss), {"", params::fraction(), "the share of the VCU's frames (IMU, wheels, steering, RES, status) lost"});
   }
 };
@@ -194,7 +196,7 @@ struct RainFault : FaultWindow {
   double grip = 0.6;          // factor on the tyres' peak friction
   template <class V>
   void visit(V& v) {
-    PADDOCK_FAULT_WINDOW(v, "rain");
+    visit_window(v, "sim time the rain begins (unset: no such fault)");
     v(PADDOCK_PARAM(returns_lost), {"", params::fraction(), "the share of the LiDAR's returns the spray and drops take"});
     v(PADDOCK_PARAM(grip), {"", params::in(0.1, 1.0), "the tyres' peak friction (lateral and longitudinal) is this times the dry one"});
   }
