@@ -28,6 +28,24 @@ bool in_sector(double a, double from, double to) {
   return off <= span;
 }
 
+// the centreline point `along` m from its start (the last point past its
+// end), its heading and its index; the centreline has >= 2 points
+struct Station {
+  Vec2 at;
+  double yaw = 0.0;
+  std::size_t i = 1;
+};
+Station station(const std::vector<Vec2>& line, double along) {
+  std::size_t i = 1;
+  double s = 0.0;
+  while (i + 1 < line.size() && s + distance(line[i - 1], line[i]) < along) {
+    s += distance(line[i - 1], line[i]);
+    ++i;
+  }
+  const Vec2 a = line[i - 1], b = line[i];
+  return {a, std::atan2(b.y - a.y, b.x - a.x), i};
+}
+
 }  // namespace
 
 std::vector<FaultNote> fault_notes(const FaultsSection& f) {
@@ -70,6 +88,11 @@ std::vector<FaultNote> fault_notes(const FaultsSection& f) {
     n.push_back({"rain", "rain: " + num(100.0 * f.rain.returns_lost) + " % of the LiDAR's returns lost, grip x " + num(f.rain.grip) + window(f.rain),
                  *f.rain.at});
   }
+  if (f.wind.at) {
+    n.push_back({"wind", "a gust moves the cones within " + num(f.wind.radius) + " m of the centreline " + num(f.wind.along) +
+                             " m along it, by " + num(f.wind.slide) + " m, " + num(100.0 * f.wind.topple) + " % toppled",
+                 *f.wind.at});
+  }
   std::stable_sort(n.begin(), n.end(), [](const FaultNote& a, const FaultNote& b) { return a.at < b.at; });
   return n;
 }
@@ -79,14 +102,7 @@ void FaultInjector::place(const world::TrackModel& track, const std::vector<Cone
   recoloured_.clear();
   if (f_.object.at && track.centreline.size() >= 2) {
     // the centreline point `along` m from its start, and its normal
-    std::size_t i = 1;
-    double s = 0.0;
-    while (i + 1 < track.centreline.size() && s + distance(track.centreline[i - 1], track.centreline[i]) < f_.object.along) {
-      s += distance(track.centreline[i - 1], track.centreline[i]);
-      ++i;
-    }
-    const Vec2 a = track.centreline[i - 1], b = track.centreline[i];
-    const double yaw = std::atan2(b.y - a.y, b.x - a.x);
+    const auto [a, yaw, i] = station(track.centreline, f_.object.along);
     const Vec2 normal{-std::sin(yaw), std::cos(yaw)};  // left
     const double half = i < track.width.size() ? 0.5 * track.width[i] : 1.5;
     const Vec2 at = a + normal * ((f_.object.left ? 1.0 : -1.0) * (half + f_.object.edge_offset));
@@ -111,6 +127,32 @@ void FaultInjector::place(const world::TrackModel& track, const std::vector<Cone
     recoloured_.assign(sides.begin(), sides.begin() + static_cast<std::ptrdiff_t>(n));
     std::sort(recoloured_.begin(), recoloured_.end());
   }
+  gust_.clear();
+  gust_done_ = false;
+  if (f_.wind.at && track.centreline.size() >= 2) {
+    // every cone within `radius` of the point, by index: a slide of 0.5-1.5
+    // times the mean, a direction within 0.2 rad of the wind's
+    const Station st = station(track.centreline, f_.wind.along);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (std::size_t i = 0; i < cones.size(); ++i) {
+      if (distance(cones[i].position, st.at) > f_.wind.radius) continue;
+      const double slide = f_.wind.slide * (0.5 + u(rng_));
+      const double dir = st.yaw + f_.wind.direction + 0.2 * (2.0 * u(rng_) - 1.0);
+      const bool topple = u(rng_) < f_.wind.topple;
+      gust_.push_back({static_cast<int>(i), Vec2{std::cos(dir), std::sin(dir)} * slide, topple});
+    }
+  }
+}
+
+std::string FaultInjector::gust_words() const {
+  const auto toppled = std::count_if(gust_.begin(), gust_.end(), [](const Gust& g) { return g.topple; });
+  return std::to_string(gust_.size()) + " cones moved, " + std::to_string(toppled) + " of them toppled";
+}
+
+std::vector<FaultInjector::Gust> FaultInjector::gust_due(double t) {
+  if (gust_done_ || !f_.wind.at || t < *f_.wind.at) return {};
+  gust_done_ = true;
+  return gust_;
 }
 
 ConeColor FaultInjector::colour(int i, ConeColor color, double t) const {

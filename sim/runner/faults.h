@@ -17,6 +17,7 @@
 //   [faults.cones]     cones of the wrong colour (blue and yellow swapped)
 //   [faults.object]    a spectator's object by the track edge: a bag, a person's legs
 //   [faults.rain]      rain: LiDAR returns lost, the tyres' grip down
+//   [faults.wind]      a gust moves the cones of a stretch of track, and topples some
 #include <cstdint>
 #include <optional>
 #include <random>
@@ -202,6 +203,24 @@ struct RainFault : FaultWindow {
   }
 };
 
+struct WindFault {
+  std::optional<double> at;
+  double along = 60.0;       // m along the centreline from its start
+  double radius = 6.0;       // m around that point
+  double direction = 1.5708; // rad from the centreline's heading there (> 0 to the left)
+  double slide = 0.5;        // m, the mean slide
+  double topple = 0.3;       // share of the moved cones that fall over
+  template <class V>
+  void visit(V& v) {
+    v(PADDOCK_PARAM(at), {"s", params::at_least(0.0), "sim time the gust comes (unset: never)"});
+    v(PADDOCK_PARAM(along), {"m", params::at_least(0.0), "where: this far along the centreline from its start"});
+    v(PADDOCK_PARAM(radius), {"m", params::in(0.0, 100.0), "the cones within this distance of that point are moved"});
+    v(PADDOCK_PARAM(direction), {"rad", params::in(-3.1416, 3.1416), "where the wind blows to, from the centreline's heading there (0 along it, > 0 to the left)"});
+    v(PADDOCK_PARAM(slide), {"m", params::in(0.0, 10.0), "how far a cone slides, on average (each from 0.5 to 1.5 times this, its direction within 0.2 rad)"});
+    v(PADDOCK_PARAM(topple), {"", params::fraction(), "the share of the moved cones that fall over"});
+  }
+};
+
 // [faults]
 struct FaultsSection {
   LidarFault lidar;
@@ -216,6 +235,7 @@ struct FaultsSection {
   ConesFault cones;
   ObjectFault object;
   RainFault rain;
+  WindFault wind;
 
   template <class V>
   void visit(V& v) {
@@ -231,6 +251,7 @@ struct FaultsSection {
     v.section(PADDOCK_PARAM(cones), "cones of the wrong colour");
     v.section(PADDOCK_PARAM(object), "a spectator's object by the track edge");
     v.section(PADDOCK_PARAM(rain), "rain: LiDAR returns lost, less grip");
+    v.section(PADDOCK_PARAM(wind), "a gust that moves cones (not the car's DOO) and topples some");
   }
 };
 
@@ -263,6 +284,16 @@ class FaultInjector {
     static const std::vector<world::Block> none;
     return f_.object.at && t >= *f_.object.at ? object_ : none;
   }
+  // the cones the gust moves: each once, at the first call at or after the
+  // gust's time (empty otherwise)
+  struct Gust {
+    int cone = -1;
+    Vec2 shift;  // m, map frame
+    bool topple = false;
+  };
+  std::vector<Gust> gust_due(double t);
+  // the gust in words: how many cones it moves, how many it topples
+  std::string gust_words() const;
   // the tyres' peak friction factor at t (1 dry)
   double grip(double t) const { return f_.rain.on(t) ? f_.rain.grip : 1.0; }
   // the camera at t: true when its frame (and so its detections) is lost
@@ -289,6 +320,8 @@ class FaultInjector {
   std::optional<double> stuck_;  // the stuck wheel's frozen reading
   std::vector<world::Block> object_;
   std::vector<int> recoloured_;  // sorted cone indices
+  std::vector<Gust> gust_;       // the gust's cones, drawn in place()
+  bool gust_done_ = false;
 };
 
 }  // namespace paddock::runner

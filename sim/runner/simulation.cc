@@ -283,6 +283,8 @@ void step(const SimModel& model, SimState& s) {
   }
   const Pose2 base = vehicle::base_pose(car, s.car);
   const Vec2 v_world = rotate(vehicle::base_velocity(car, s.car), base.yaw);
+  // a gust ([faults.wind]) moves cones: not the car's doing
+  for (const FaultInjector::Gust& g : s.faults.gust_due(s.t)) s.cones.disturb_cone(g.cone, g.shift, g.topple);
   s.cones.step(base, v_world.x, v_world.y, s.car.r, model.dt);
   measure_ebs_stop(model, s, norm(v_world));
   const double t0 = s.t;
@@ -326,6 +328,9 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
   RunResult result = results_of(state);
   result.stack_remote = state.hal.remote();
   result.faults = fault_notes(scenario.faults);
+  for (FaultNote& n : result.faults) {
+    if (n.name == "wind") n.what += " (" + state.faults.gust_words() + ")";
+  }
   result.log = std::move(log.rows());
   result.sim_time = result.log.empty() ? 0.0 : result.log.back().t;
   tracking_from_log(result.event.laps, result.log, 1.0 / scenario.sim.log_rate, result.lap_tracking, result.tracking);

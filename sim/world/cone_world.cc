@@ -83,6 +83,7 @@ struct ConeWorld::Impl : public b2ContactListener {
   std::vector<const ConeSpec*> spec;
   std::vector<b2Body*> body;          // nullptr while the cone is not in the Box2D world
   std::vector<b2Vec2> start;          // Box2D start position
+  std::vector<b2Vec2> home;           // Box2D position the out test measures from (start, or where the wind left it)
   std::vector<b2Vec2> rest_pos;       // Box2D position while out of the world
   std::vector<float> rest_angle;      // rad, Box2D angle while out of the world
   std::vector<Vec2> position;         // current map position
@@ -90,6 +91,7 @@ struct ConeWorld::Impl : public b2ContactListener {
   std::vector<double> step_impulse;   // N s, summed over this step's contacts
   std::vector<double> rest;           // s at rest
   std::vector<std::uint8_t> is_active, off_grid, knocked, doo;
+  std::vector<std::uint8_t> external;  // moving by an outside cause (disturb_cone): its DOO is not the car's
   std::vector<std::int64_t> doo_step, doo_time;
   std::vector<int> active;    // awake cones, in the order they woke
   std::vector<int> moved;     // cones taken off the grid (in the world at least once)
@@ -153,6 +155,8 @@ struct ConeWorld::Impl : public b2ContactListener {
     const int a = cone_of(c->GetFixtureA()), b = cone_of(c->GetFixtureB());
     if (a >= 0) { activate(a); step_impulse[a] += j; }
     if (b >= 0) { activate(b); step_impulse[b] += j; }
+    // a cone pushed by a cone the wind moves moves by the wind too
+    if (a >= 0 && b >= 0 && (external[a] || external[b])) external[a] = external[b] = 1;
   }
 };
 
@@ -212,6 +216,7 @@ ConeWorld::Impl::Impl(std::vector<Cone> cones_in, const ConeWorldParams& p, cons
   spec.resize(n);
   body.assign(n, nullptr);
   start.resize(n);
+  home.resize(n);
   rest_pos.resize(n);
   rest_angle.assign(n, 0.0f);
   position.resize(n);
@@ -221,6 +226,7 @@ ConeWorld::Impl::Impl(std::vector<Cone> cones_in, const ConeWorldParams& p, cons
   is_active.assign(n, 0);
   off_grid.assign(n, 0);
   knocked.assign(n, 0);
+  external.assign(n, 0);
   doo.assign(n, 0);
   doo_step.assign(n, -1);
   doo_time.assign(n, -1);
@@ -230,6 +236,7 @@ ConeWorld::Impl::Impl(std::vector<Cone> cones_in, const ConeWorldParams& p, cons
     max_radius = std::max(max_radius, radius[i]);
     position[i] = cones[i].position;
     start[i] = to_b2(cones[i].position);
+    home[i] = start[i];
     rest_pos[i] = start[i];
   }
   build_grid();
@@ -441,14 +448,16 @@ void ConeWorld::Impl::after_box2d_step(const Pose2& to, double dt, double motion
     // knocked over: the impulse of this step exceeded what tips the cone
     if (step_impulse[i] > spec[i]->knock_impulse) {
       knocked[i] = 1;
-      if (!doo[i]) {
+      if (!doo[i] && !external[i]) {
         doo[i] = 1;
         scratch.push_back(i);
       }
     }
     step_impulse[i] = 0.0;
-    // out: moved by more than its base radius
-    if (!doo[i] && squared_norm(disp) > radius[i] * radius[i]) {
+    // out: moved by more than its base radius from where it stood
+    const Vec2 from_home{static_cast<double>(now.x) - static_cast<double>(home[i].x),
+                         static_cast<double>(now.y) - static_cast<double>(home[i].y)};
+    if (!doo[i] && !external[i] && squared_norm(from_home) > radius[i] * radius[i]) {
       doo[i] = 2;
       scratch.push_back(i);
     }
@@ -471,6 +480,11 @@ void ConeWorld::Impl::after_box2d_step(const Pose2& to, double dt, double motion
       active[keep++] = i;
     } else {
       is_active[i] = 0;
+      // the wind's cone at rest: where it stands now is its place
+      if (external[i]) {
+        external[i] = 0;
+        home[i] = now;
+      }
     }
   }
   active.resize(keep);
@@ -558,6 +572,20 @@ void ConeWorld::kick_cone(int i, Vec2 velocity) {
   w.body[i]->SetAwake(true);
   w.activate(i);
   w.query_valid = false;
+}
+
+void ConeWorld::disturb_cone(int i, Vec2 shift, bool topple) {
+  Impl& w = *impl_;
+  if (i < 0 || i >= cone_count()) throw std::out_of_range("ConeWorld::disturb_cone: no cone " + std::to_string(i));
+  if (!finite(shift.x) || !finite(shift.y)) return;
+  if (topple) w.knocked[i] = 1;
+  const double d = norm(shift);
+  if (d <= 0.0) return;
+  // Coulomb friction decelerates at mu g: v^2 = 2 mu g d
+  const double decel = w.params.ground_friction * kGravity;
+  const double speed = decel > 0.0 ? std::sqrt(2.0 * decel * d) : d;
+  w.external[i] = 1;
+  kick_cone(i, shift * (speed / d));
 }
 
 int ConeWorld::cone_count() const { return static_cast<int>(impl_->cones.size()); }

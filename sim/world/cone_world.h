@@ -160,10 +160,21 @@ class ConeWorld {
   // Throws std::out_of_range for a bad index; a non-finite velocity is ignored.
   void kick_cone(int i, Vec2 velocity);
 
+  // an outside force (the wind) moves cone i: it slides `shift` (m, map frame)
+  // on the ground's friction (it is given the speed sqrt(2 mu g |shift|)
+  // along it; with no friction it keeps |shift| per second) and, if
+  // `topple`, lies on its side from now on (cone_knocked). What it does until
+  // it rests again is not the car's: neither its own DOO nor that of a cone it
+  // pushes is counted (the cones it touches share the outside cause). Once at
+  // rest it stands in a new place: a cone is out when moved more than its base
+  // radius from there, and a toppled cone the car hits counts as knocked.
+  // Throws std::out_of_range for a bad index; a non-finite shift is ignored.
+  void disturb_cone(int i, Vec2 shift, bool topple);
+
   int cone_count() const;
   const Cone& cone(int i) const;     // as given to the constructor
   Vec2 cone_position(int i) const;   // current position (m); bit-identical to the input while untouched
-  bool cone_knocked(int i) const;    // ever hit by an impulse above its knock threshold
+  bool cone_knocked(int i) const;    // lying: ever hit by an impulse above its knock threshold, or toppled
   bool cone_doo(int i) const;
   int doo_count() const;
   std::vector<int> doo_cones() const;           // cone indices, in the order they became DOO

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -175,6 +176,60 @@ TEST(Faults, TheObjectStandsBesideTheBoundaryAndTheColoursSwapOnTime) {
   EXPECT_NEAR(static_cast<double>(pts.size()), 0.75 * n, 4.5 * std::sqrt(n * 0.25 * 0.75));
   EXPECT_EQ(rain.grip(1.0), r.rain.grip);
   EXPECT_EQ(FaultInjector(FaultsSection{}, 5).grip(1.0), 1.0);
+}
+
+TEST(Faults, TheGustMovesTheConesAroundItsPointOnceInItsDirection) {
+  // the straight track along +x; the wind blows to the left of the heading
+  world::TrackModel track;
+  for (int i = 0; i <= 200; ++i) {
+    track.centreline.push_back({0.5 * i, 0.0});
+    track.width.push_back(3.0);
+  }
+  std::vector<Cone> cones;
+  for (int i = 0; i < 20; ++i) {
+    cones.push_back({{5.0 * i, 1.5}, ConeColor::Blue});
+    cones.push_back({{5.0 * i, -1.5}, ConeColor::Yellow});
+  }
+  FaultsSection f;
+  f.wind.at = 4.0;
+  f.wind.along = 40.0;
+  f.wind.radius = 6.0;
+  f.wind.direction = kPi / 2.0;
+  f.wind.slide = 0.4;
+  f.wind.topple = 0.5;
+  FaultInjector inj(f, 7);
+  inj.place(track, cones);
+  EXPECT_TRUE(inj.gust_due(3.999).empty());
+  const std::vector<FaultInjector::Gust> g = inj.gust_due(4.0);
+  EXPECT_TRUE(inj.gust_due(4.5).empty()) << "once";
+  // brute force: the cones within 6 m of (40, 0) are those at x = 35, 40, 45
+  std::vector<int> want;
+  for (int i = 0; i < static_cast<int>(cones.size()); ++i)
+    if (std::hypot(cones[static_cast<std::size_t>(i)].position.x - 40.0, cones[static_cast<std::size_t>(i)].position.y) <= 6.0) want.push_back(i);
+  ASSERT_EQ(want.size(), 6u);
+  std::vector<int> got;
+  for (const FaultInjector::Gust& k : g) {
+    got.push_back(k.cone);
+    EXPECT_GE(norm(k.shift), 0.2 - 1e-12);
+    EXPECT_LE(norm(k.shift), 0.6 + 1e-12);
+    EXPECT_NEAR(std::atan2(k.shift.y, k.shift.x), kPi / 2.0, 0.2 + 1e-12);
+  }
+  EXPECT_EQ(got, want);
+  const auto toppled = std::count_if(g.begin(), g.end(), [](const FaultInjector::Gust& k) { return k.topple; });
+  EXPECT_EQ(inj.gust_words(), "6 cones moved, " + std::to_string(toppled) + " of them toppled");
+  // the same seed draws the same gust
+  FaultInjector again(f, 7);
+  again.place(track, cones);
+  const std::vector<FaultInjector::Gust> h = again.gust_due(5.0);
+  ASSERT_EQ(h.size(), g.size());
+  for (std::size_t i = 0; i < g.size(); ++i) {
+    EXPECT_EQ(h[i].shift.x, g[i].shift.x);
+    EXPECT_EQ(h[i].topple, g[i].topple);
+  }
+  const std::vector<FaultNote> notes = fault_notes(f);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_EQ(notes[0].name, "wind");
+  EXPECT_EQ(notes[0].at, 4.0);
 }
 
 }  // namespace

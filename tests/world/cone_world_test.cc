@@ -364,5 +364,62 @@ TEST(ConeWorld, AFlyingConeKnocksAnother) {
   EXPECT_EQ(most_bodies, 2);
 }
 
+TEST(ConeWorld, AConeTheWindMovesIsNotTheCarsDoo) {
+  // the wind slides cone 0 by 0.6 m across the lane: it stops at the Coulomb
+  // distance (the speed it is given is sqrt(2 mu g d)), and neither it nor the
+  // cone it is blown into counts; the car stands far away
+  const ConeWorldParams p;
+  for (const bool topple : {false, true}) {
+    ConeWorld w({{{20.0, 1.5}, ConeColor::Blue}, {{20.0, 0.9}, ConeColor::Blue}, {{40.0, 1.5}, ConeColor::Blue}}, p, kCar);
+    w.disturb_cone(0, {0.0, -0.6}, topple);
+    w.disturb_cone(2, {0.5, 0.0}, false);
+    EXPECT_EQ(w.cone_knocked(0), topple);
+    drive(w, [](double) { return Pose2{-50.0, 0.0, 0.0}; }, 0.0, 3.0);
+    EXPECT_EQ(w.doo_count(), 0) << "topple " << topple;
+    // cone 2 slid freely: the Coulomb distance, in the wind's direction
+    EXPECT_NEAR(w.cone_position(2).x - 40.0, 0.5, 0.02);
+    EXPECT_NEAR(w.cone_position(2).y, 1.5, 1e-3);
+    // cone 0 was blown into cone 1 (0.6 m away, edges 0.372 m apart) and pushed it
+    EXPECT_LT(w.cone_position(1).y, 0.9 - 0.01);
+    EXPECT_FALSE(w.cone_doo(0));
+    EXPECT_FALSE(w.cone_doo(1));
+    EXPECT_EQ(w.bodies_in_world(), 0) << "all at rest again, off Box2D";
+    // where the wind left it is its place now: a nudge of 8 mm from there is
+    // no DOO (it would be from where it first stood)
+    w.kick_cone(2, {0.3, 0.0});
+    drive(w, [](double) { return Pose2{-50.0, 0.0, 0.0}; }, 3.0, 4.0);
+    EXPECT_GT(w.cone_position(2).x - 40.0, 0.5);
+    EXPECT_EQ(w.doo_count(), 0);
+  }
+}
+
+TEST(ConeWorld, AConeTheWindMovedCountsWhenTheCarHitsItWhereItStands) {
+  // the wind slides a cone 0.5 m into the car's lane; at rest, its new place
+  // is its own: the car hitting it there at 10 m/s knocks it over (the car's
+  // DOO); so does a cone the wind toppled, when the car then hits it
+  const ConeWorldParams p;
+  ConeWorld w({{{10.0, 0.7}, ConeColor::Yellow}, {{30.0, 0.5}, ConeColor::Yellow}}, p, kCar);
+  w.disturb_cone(0, {0.0, -0.5}, false);
+  w.disturb_cone(1, {0.0, -0.3}, true);
+  // the car waits 1 s (the cones settle), then drives through both at 10 m/s
+  const double x0 = -30.0;
+  drive(w, [&](double t) { return Pose2{x0 + 10.0 * std::max(0.0, t - 1.0), 0.0, 0.0}; }, 0.0, 8.0);
+  EXPECT_EQ(w.doo_cones(), (std::vector<int>{0, 1}));
+  EXPECT_EQ(w.doo_events()[0].cause, DooCause::Knocked);
+  // the wind had left cone 0 0.5 m further in: the car met it there
+  EXPECT_GT(w.cone_position(0).x, 13.0);
+  EXPECT_TRUE(w.cone_knocked(1));
+}
+
+TEST(ConeWorld, DisturbingChecksItsCone) {
+  ConeWorld w({{{10.0, 0.7}, ConeColor::Yellow}}, ConeWorldParams{}, kCar);
+  EXPECT_THROW(w.disturb_cone(1, {0.1, 0.0}, false), std::out_of_range);
+  EXPECT_THROW(w.disturb_cone(-1, {0.1, 0.0}, false), std::out_of_range);
+  w.disturb_cone(0, {std::nan(""), 0.0}, true);  // ignored
+  EXPECT_FALSE(w.cone_knocked(0));
+  drive(w, [](double) { return Pose2{-50.0, 0.0, 0.0}; }, 0.0, 1.0);
+  EXPECT_EQ(w.cone_position(0).x, 10.0);
+}
+
 }  // namespace
 }  // namespace paddock::world
