@@ -40,8 +40,9 @@ const char* kUsage =
     "              [--plots [PLOT OPTIONS]]\n"
     "      runs a scenario headless and prints the result; writes DIR/summary.json,\n"
     "      DIR/scenario.ini (resolved, defaults included) and DIR/log.csv\n"
-    "      (DIR defaults to runs/<scenario name>). --json prints the summary as JSON;\n"
-    "      --quiet prints only failed expectations; --plots also draws the figures;\n"
+    "      (DIR defaults to runs/<scenario name> in the current folder). --json prints\n"
+    "      the summary as JSON; --quiet prints only failed expectations; --plots also\n"
+    "      draws the figures;\n"
     "      --log writes DIR/run.mcap (a wire run: the LiDAR's packets, the CAN frames,\n"
     "      the stack's outputs in Foxglove's schemas).\n"
     "      Exit 3 when [expect] fails.\n"
@@ -95,8 +96,8 @@ const char* kUsage =
     "  paddock report vehicle [CAR.ini] [--out DIR] [--chart-size WxH] [--dpi D]\n"
     "      the car's figures from experiments on the simulated car: 0-75 m, top speed,\n"
     "      braking from 100 km/h, the skidpad limit and the g-g-v envelope; writes\n"
-    "      DIR/vehicle_report.json and DIR/ggv.png (CAR.ini defaults to\n"
-    "      scenarios/vehicles/default.ini, DIR to runs/vehicle_<car name>)\n"
+    "      DIR/vehicle_report.json and DIR/ggv.png (CAR.ini defaults to the paddock\n"
+    "      tree's scenarios/vehicles/default.ini, DIR to runs/vehicle_<car name>)\n"
     "  paddock report limit SCENARIO.ini [--clearance M] [--set section.key=value]...\n"
     "              [--out DIR] [--map-size N] [--dpi D]\n"
     "      the fastest flying lap the scenario's car can drive on its circuit: its\n"
@@ -267,7 +268,8 @@ int cmd_report_vehicle(const std::vector<std::string>& args) {
       throw UserError("report vehicle: more than one vehicle file given: " + car + " and " + a);
     }
   }
-  if (car.empty()) car = "scenarios/vehicles/default.ini";
+  // the default: the paddock tree's own car, wherever the command is run
+  if (car.empty()) car = std::string(PADDOCK_SOURCE_DIR) + "/scenarios/vehicles/default.ini";
   const vehicle::VehicleParams params = load_vehicle_file(car);
   // like run's runs/<scenario name>
   if (out_dir.empty()) out_dir = "runs/vehicle_" + std::filesystem::path(car).stem().string();

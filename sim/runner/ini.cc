@@ -67,6 +67,7 @@ class Reader {
       if (!valid_name(key)) throw UserError(where + ": bad key '" + key + "', expected letters, digits and _");
       if (key == "include") {
         if (value.empty()) throw UserError(where + ": include needs a path");
+        if (base_dir.empty()) throw UserError(where + ": include is not allowed here (text that is not a file includes nothing)");
         include((base_dir / value).lexically_normal(), where);
         continue;
       }

@@ -33,6 +33,7 @@ std::vector<IniEntry> read_ini_file(const std::string& path);
 std::string trim(const std::string& s);
 
 // the same for text already in memory; includes are read relative to base_dir
+// (an empty base_dir: the text may include nothing, e.g. a log's scenario)
 std::vector<IniEntry> parse_ini_text(const std::string& text, const std::string& source,
                                      const std::string& base_dir);
 

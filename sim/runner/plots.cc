@@ -109,7 +109,11 @@ std::vector<std::string> plot_perception(const std::string& dir, const render::F
                                 color_of_tag(b.at(4).get<std::string>())});
       for (const auto& p : c.at("projected")) camera.projected.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
       for (const auto& p : c.at("dropped")) camera.dropped.push_back({p.at(0).get<double>(), p.at(1).get<double>()});
-      const std::string png = read_file(dir + "/" + c.at("image").get<std::string>());
+      // the image lies in the run's folder: a name, never a path out of it
+      const std::string image = c.at("image").get<std::string>();
+      if (image.empty() || image.find('/') != std::string::npos || image == "." || image == "..")
+        throw UserError(dir + "/perception.json: camera.image '" + image + "': expected a file name in " + dir);
+      const std::string png = read_file(dir + "/" + image);
       const render::Image img = render::decode_png(std::vector<std::uint8_t>(png.begin(), png.end()));
       if (img.width != camera.width || img.height != camera.height)
         throw UserError(dir + "/camera.png: " + std::to_string(img.width) + "x" + std::to_string(img.height) +

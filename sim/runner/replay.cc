@@ -1,7 +1,6 @@
 #include "sim/runner/replay.h"
 
-#include <unistd.h>
-
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -21,6 +20,7 @@
 #include "autonomy/log/mcap.h"
 #include "autonomy/stack/stack.h"
 #include "sim/runner/files.h"
+#include "sim/runner/ini.h"
 #include "sim/runner/model.h"
 #include "sim/runner/scenario.h"
 #include "sim/world/track.h"
@@ -66,23 +66,31 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
     if (!files.count(need))
       throw UserError(path + ": no attachment " + need + "; expected a log of `paddock run ... --log`");
   }
-  // the scenario as the run resolved it, its files beside it, the user's changes last
-  namespace fs = std::filesystem;
-  const fs::path dir = o.extract_dir.empty()
-                           ? fs::temp_directory_path() / ("paddock_replay_" + std::to_string(::getpid()))
-                           : fs::path(o.extract_dir);
-  fs::create_directories(dir);
+  // the scenario as the run resolved it, with the log's own files, the user's
+  // changes last. Nothing is written and nothing the log names is read from
+  // disk: its attachments stay in memory, named LOG/NAME (in messages too)
+  const std::string base = std::filesystem::absolute(path).lexically_normal().string();
+  const auto attached = [&base](const std::string& name) { return base + "/" + name; };
+  FileTable table;
   std::vector<std::string> overrides;
-  for (const auto& [name, text] : files) {
-    const std::string f = fs::absolute(dir / name).string();
-    write_file_atomic(f, text);
-    if (name == "track.csv") overrides.push_back("scenario.track=" + f);
-    if (name == "car.dbc") overrides.push_back("hal.dbc=" + f);
-    if (name == "lidar_metadata.json") overrides.push_back("hal.lidar_metadata=" + f);
+  for (const auto& [name, key] : {std::pair<std::string, std::string>{"track.csv", "scenario.track"},
+                                  {"car.dbc", "hal.dbc"},
+                                  {"lidar_metadata.json", "hal.lidar_metadata"}}) {
+    if (!files.count(name)) continue;
+    table[attached(name)] = files[name];
+    overrides.push_back(key + "=" + attached(name));
   }
   overrides.insert(overrides.end(), o.overrides.begin(), o.overrides.end());
-  const Scenario scenario = load_scenario((dir / "scenario.ini").string(), overrides);
-  const world::TrackModel track = world::build_track(load_track_file(scenario.track_path));
+  std::vector<IniEntry> entries = parse_ini_text(files["scenario.ini"], attached("scenario.ini"), "");
+  // a file the log's scenario names but does not carry is not read
+  entries.erase(std::remove_if(entries.begin(), entries.end(),
+                               [](const IniEntry& e) { return e.section == "hal" && e.key == "lidar_metadata"; }),
+                entries.end());
+  const Scenario scenario = load_scenario_entries(std::move(entries), attached("scenario.ini"), overrides, &table);
+  const auto track_text = table.find(scenario.scenario.track);
+  const world::TrackModel track = world::build_track(track_text != table.end()
+                                                         ? world::parse_track(track_text->second, scenario.scenario.track)
+                                                         : load_track_file(scenario.track_path));
   const SimModel model = compile_model(scenario, track);
 
   // the car: its decoders, its stack and its watchdogs, as the car binary has them

@@ -21,7 +21,6 @@ struct ReplayOptions {
   std::vector<std::string> overrides;  // --set section.key=value (the stack's keys)
   std::optional<double> from;          // s: the stack starts here (fresh), the log before it unread
   std::optional<double> until;         // s: stops here
-  std::string extract_dir;             // where the log's attachments are written (the scenario reads them)
 };
 
 struct ReplayResult {

@@ -182,11 +182,17 @@ void require_given(const std::vector<Key>& keys, const Given& given, const std::
 // the [hal] files: the LiDAR's metadata sets its layout (a [lidar] key it
 // sets may be given only with the file's value), the DBC is parsed and
 // checked against what the car sends; wire needs both where they are used
-void load_hal_files(Scenario& s, const std::vector<IniEntry>& entries, const std::string& path) {
+void load_hal_files(Scenario& s, const std::vector<IniEntry>& entries, const std::string& path, const FileTable* files) {
+  const auto read = [files](const std::string& file) {
+    if (files) {
+      if (const auto it = files->find(file); it != files->end()) return it->second;
+    }
+    return read_file(file);
+  };
   if (!s.hal.lidar_metadata.empty()) {
     const std::string& file = s.hal.lidar_metadata;
     try {
-      s.lidar_info = hal::ouster::parse_sensor_info(read_file(file), file);
+      s.lidar_info = hal::ouster::parse_sensor_info(read(file), file);
     } catch (const std::invalid_argument& e) {
       throw UserError(e.what());
     }
@@ -214,7 +220,7 @@ void load_hal_files(Scenario& s, const std::vector<IniEntry>& entries, const std
   if (!s.hal.dbc.empty()) {
     const std::string& file = s.hal.dbc;
     try {
-      s.dbc_text = read_file(file);
+      s.dbc_text = read(file);
       s.dbc = std::make_shared<const hal::Dbc>(hal::parse_dbc(s.dbc_text, file));
       // the car's frames must all be there (throws naming what is missing)
       const hal::CarCan check(*s.dbc, file);
@@ -233,7 +239,7 @@ void load_hal_files(Scenario& s, const std::vector<IniEntry>& entries, const std
 
 // sets every entry's key; unknown sections and keys, and required keys left
 // unset, are errors
-void apply_entries(Scenario& s, const std::vector<IniEntry>& entries, const std::string& path) {
+void apply_entries(Scenario& s, const std::vector<IniEntry>& entries, const std::string& path, const FileTable* files) {
   std::vector<Key> keys = scenario_keys(s);
   const Given given = set_keys(keys, entries, [&s](const Key& k, const IniEntry& e) {
     if (k.path() == "scenario.track") resolve_track(s, e);
@@ -242,7 +248,7 @@ void apply_entries(Scenario& s, const std::vector<IniEntry>& entries, const std:
   });
   require_given(keys, given, path, "; include a vehicle file, e.g. include = vehicles/default.ini");
   if (s.track_path.empty()) throw UserError(path + ": [scenario] track is not set; expected the track's CSV file");
-  load_hal_files(s, entries, path);
+  load_hal_files(s, entries, path, files);
 }
 
 // a problem from params::validate ("a.b.key must be ...") as "[a.b] key must be ..."
@@ -276,11 +282,11 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
 }
 
 Scenario load_scenario_entries(std::vector<IniEntry> entries, const std::string& path,
-                               const std::vector<std::string>& overrides) {
+                               const std::vector<std::string>& overrides, const FileTable* files) {
   // command-line overrides come last, so they win
   for (std::size_t i = 0; i < overrides.size(); ++i) entries.push_back(override_entry(overrides[i], static_cast<int>(i + 1)));
   Scenario s;
-  apply_entries(s, entries, path);
+  apply_entries(s, entries, path, files);
   // every field's bounds were checked as it was read; what ties fields
   // together is checked on the whole tree, the stack's sections as the stack
   // receives them (with the calibrations the runner derives from [lidar] and

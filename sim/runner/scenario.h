@@ -3,6 +3,7 @@
 // program, with every default filled in and an explicit seed. Nothing inside
 // sim/ or autonomy/ reads files; they get pieces of this.
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -248,8 +249,11 @@ Scenario load_scenario(const std::string& path, const std::vector<std::string>& 
 // the same from entries already read (a sweep's point: its base scenario's
 // entries, then the sweep's own); `path` names the scenario and its stem
 // the run
+// `files`, if given, holds files in memory by their absolute path (a log's
+// attachments): the LiDAR metadata and the DBC are read from it first
+using FileTable = std::map<std::string, std::string>;
 Scenario load_scenario_entries(std::vector<IniEntry> entries, const std::string& path,
-                               const std::vector<std::string>& overrides = {});
+                               const std::vector<std::string>& overrides = {}, const FileTable* files = nullptr);
 
 // a vehicle parameter file (scenarios/vehicles/default.ini's format: one
 // [vehicle] section, includes allowed) read with the scenario's keys and

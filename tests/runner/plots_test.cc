@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include <nlohmann/json.hpp>
 
@@ -87,6 +88,16 @@ TEST(Plots, RawSensorRunsWriteThePerceptionSnapshotAndItsFigures) {
     EXPECT_LT(best, 0.3);
   }
   EXPECT_GT(j.at("camera").at("boxes").size(), 3u);
+  // the snapshot names its image: a name in the run's folder, never a path out of it
+  nlohmann::json bad = j;
+  bad["camera"]["image"] = "../perception_lidar/camera.png";
+  {
+    std::ofstream f(dir + "/perception.json");
+    f << bad.dump();
+  }
+  const auto escaped = paddock("plot " + dir);
+  EXPECT_EQ(escaped.code, 2) << escaped.output;
+  EXPECT_THAT(escaped.output, HasSubstr("camera.image '../perception_lidar/camera.png': expected a file name in"));
   // lidar alone: no camera, so no camera figure
   const std::string lidar_dir = scratch("perception_lidar");
   const auto l = paddock("run " + kRoot + "/scenarios/fsg_2023_trackdrive.ini --set autonomy.perception=lidar --set event.timeout=10 --set sim.snapshot_time=8 --plots --out " + lidar_dir);

@@ -3,7 +3,8 @@
 // team opens in Foxglove; the replay, with no simulator, hands the stack the
 // recorded packets and frames through the car's decoders and gets the live
 // run's commands to the bit; a changed stack (--set) is told where it
-// differs; a file that is no log, or a cut one, is a clear error
+// differs; a file that is no log, or a cut one, is a clear error; a replay
+// writes nothing and reads nothing a hostile log names
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -128,6 +129,57 @@ TEST(RunLog, ALogNeedsTheWireAndAReplayNeedsALog) {
   EXPECT_NE(short_log.output.find("cut short or damaged"), std::string::npos) << short_log.output;
   const testing::Outcome bad_time = testing::run_paddock("replay " + cut.string() + " --from -3");
   EXPECT_NE(bad_time.output.find("--from -3: expected a time in seconds >= 0"), std::string::npos) << bad_time.output;
+}
+
+// a log of the logged run's attachments (no messages), some replaced or added
+fs::path log_with(const std::string& name, const std::map<std::string, std::string>& changed) {
+  log::McapReader reader(std::make_unique<log::FileSource>((logged_run() / "run.mcap").string()));
+  reader.open();
+  std::map<std::string, std::vector<std::uint8_t>> files;
+  for (const log::Attachment& a : reader.read_attachments()) files[a.name] = a.data;
+  for (const auto& [n, text] : changed) files[n] = std::vector<std::uint8_t>(text.begin(), text.end());
+  const fs::path out = fs::temp_directory_path() / ("paddock_" + name + "_" + std::to_string(::getpid()) + ".mcap");
+  log::McapWriter w(std::make_unique<log::FileSink>(out.string()));
+  for (const auto& [n, data] : files) w.write_attachment({0, 0, n, "text/plain", data});
+  w.close();
+  return out;
+}
+
+TEST(RunLog, AReplayWritesNothingAndReadsOnlyTheLogAndWhatTheUserNames) {
+  // attachment names that would escape a folder, and a scenario that names a
+  // file of its own: nothing is written, nothing but the log is read
+  const fs::path escape = fs::temp_directory_path() / ("paddock_escaped_" + std::to_string(::getpid()));
+  fs::remove(escape);
+  const fs::path hostile = log_with("hostile", {{"../../../../../../" + escape.string(), "written?"}, {escape.string(), "written?"}});
+  const testing::Outcome ok = testing::run_paddock("replay " + hostile.string() + " --until 6");
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_NE(ok.output.find("1 control cycles"), std::string::npos) << ok.output;  // a log of attachments only
+  EXPECT_FALSE(fs::exists(escape)) << "a log's attachment name wrote a file";
+  // the log's scenario may include nothing
+  log::McapReader reader(std::make_unique<log::FileSource>((logged_run() / "run.mcap").string()));
+  reader.open();
+  std::string ini;
+  for (const log::Attachment& a : reader.read_attachments())
+    if (a.name == "scenario.ini") ini.assign(a.data.begin(), a.data.end());
+  ASSERT_FALSE(ini.empty());
+  const fs::path including = log_with("including", {{"scenario.ini", "include = /etc/hostname\n" + ini}});
+  const testing::Outcome inc = testing::run_paddock("replay " + including.string());
+  EXPECT_EQ(inc.code, 2) << inc.output;
+  EXPECT_NE(inc.output.find(including.string() + "/scenario.ini:1: include is not allowed here"), std::string::npos)
+      << inc.output;
+  // an error in an attachment is named by the log and the attachment
+  const fs::path bad_track = log_with("bad_track", {{"track.csv", "x,y,color\n1,2,purple\n"}});
+  const testing::Outcome bt = testing::run_paddock("replay " + bad_track.string());
+  EXPECT_EQ(bt.code, 2) << bt.output;
+  EXPECT_NE(bt.output.find(bad_track.string() + "/track.csv"), std::string::npos) << bt.output;
+  // an attachment over the 64 MiB a replay reads is refused before it is read
+  const fs::path huge = log_with("huge", {{"big.bin", std::string(64u * 1024u * 1024u + 1u, 'x')}});
+  const testing::Outcome h = testing::run_paddock("replay " + huge.string());
+  EXPECT_EQ(h.code, 2) << h.output;
+  EXPECT_NE(h.output.find("attachment big.bin of 67108865 bytes, more than the 67108864 a replay reads: refused"),
+            std::string::npos)
+      << h.output;
+  for (const fs::path& f : {hostile, including, bad_track, huge}) fs::remove(f);
 }
 
 }  // namespace

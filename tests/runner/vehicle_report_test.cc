@@ -120,13 +120,12 @@ TEST(ReportVehicleCli, BadKeysAndValuesAreFileLineErrorsAndExit2) {
   EXPECT_THAT(o.output, HasSubstr("unknown option --map-size"));
 }
 
-// the command with its defaults (the default car, runs/vehicle_default) in a
-// scratch folder holding a copy of the default car
+// the command with its defaults (the tree's default car, runs/vehicle_default
+// in the current folder) in an empty scratch folder
 TEST(ReportVehicleCli, WritesTheJsonAndTheFigureOfTheStatedSize) {
   const fs::path dir = scratch("cwd");
   fs::remove_all(dir);
-  fs::create_directories(dir / "scenarios/vehicles");
-  fs::copy_file(kRoot + "/scenarios/vehicles/default.ini", dir / "scenarios/vehicles/default.ini");
+  fs::create_directories(dir);
   // (run_paddock starts in the test's folder: this one starts in the scratch one)
   std::string output;
   {
@@ -143,7 +142,7 @@ TEST(ReportVehicleCli, WritesTheJsonAndTheFigureOfTheStatedSize) {
   }
   const fs::path out = dir / "runs/vehicle_default";
   const nlohmann::json j = nlohmann::json::parse(read_file((out / "vehicle_report.json").string()));
-  EXPECT_EQ(j.at("vehicle"), "scenarios/vehicles/default.ini");
+  EXPECT_EQ(j.at("vehicle"), kRoot + "/scenarios/vehicles/default.ini");
   const double top = j.at("top_speed").at("speed");
   EXPECT_NEAR(j.at("top_speed").at("speed_kmh").get<double>(), 3.6 * top, 1e-9);
   EXPECT_TRUE(j.at("acceleration_75m").at("reached").get<bool>());
@@ -173,7 +172,7 @@ TEST(ReportVehicleCli, WritesTheJsonAndTheFigureOfTheStatedSize) {
   // the same car in this process gives the same file, byte for byte
   const vehicle::VehicleParams p = load_vehicle_file(kRoot + "/scenarios/vehicles/default.ini");
   EXPECT_EQ(read_file((out / "vehicle_report.json").string()),
-            vehicle_report_json(vehicle_report(p, "scenarios/vehicles/default.ini")));
+            vehicle_report_json(vehicle_report(p, kRoot + "/scenarios/vehicles/default.ini")));
 }
 
 }  // namespace
