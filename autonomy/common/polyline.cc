@@ -109,18 +109,30 @@ std::optional<double> crossing_right_to_left(Vec2 p0, Vec2 p1, const Segment& g)
 }
 
 double polyline_distance(const std::vector<Vec2>& pts, bool closed, Vec2 q) {
-  double best = std::numeric_limits<double>::infinity();
   const std::size_t n = pts.size();
-  if (n < 2) return best;
+  if (n < 2) return std::numeric_limits<double>::infinity();
+  // the nearest segment by squared distance (no hypot per segment), then its
+  // distance as point_segment_distance gives it
+  double best = std::numeric_limits<double>::infinity(), best2 = best;
+  std::size_t nearest = 0;
   for (std::size_t i = 0; i < (closed ? n : n - 1); ++i) {
     const Vec2 a = pts[i], b = pts[(i + 1) % n];
     // skip segments whose bounding box is farther than the best so far
     const double dx = std::max({std::min(a.x, b.x) - q.x, q.x - std::max(a.x, b.x), 0.0});
     const double dy = std::max({std::min(a.y, b.y) - q.y, q.y - std::max(a.y, b.y), 0.0});
     if (dx >= best || dy >= best) continue;
-    best = std::min(best, point_segment_distance(q, a, b));
+    const Vec2 ab = b - a;
+    const double len2 = squared_norm(ab);
+    const double t = len2 > 0.0 ? std::clamp(dot(q - a, ab) / len2, 0.0, 1.0) : 0.0;
+    const double d2 = squared_norm(q - (a + ab * t));
+    if (d2 < best2) {
+      best2 = d2;
+      best = std::sqrt(d2);
+      nearest = i;
+    }
   }
-  return best;
+  if (best2 == std::numeric_limits<double>::infinity()) return best2;  // none compared (e.g. q not finite)
+  return point_segment_distance(q, pts[nearest], pts[(nearest + 1) % n]);
 }
 
 double point_segment_distance(Vec2 q, Vec2 a, Vec2 b) {
