@@ -121,10 +121,7 @@ double polyline_distance(const std::vector<Vec2>& pts, bool closed, Vec2 q) {
     const double dx = std::max({std::min(a.x, b.x) - q.x, q.x - std::max(a.x, b.x), 0.0});
     const double dy = std::max({std::min(a.y, b.y) - q.y, q.y - std::max(a.y, b.y), 0.0});
     if (dx >= best || dy >= best) continue;
-    const Vec2 ab = b - a;
-    const double len2 = squared_norm(ab);
-    const double t = len2 > 0.0 ? std::clamp(dot(q - a, ab) / len2, 0.0, 1.0) : 0.0;
-    const double d2 = squared_norm(q - (a + ab * t));
+    const double d2 = project_on_segment(q, a, b).distance2;
     if (d2 < best2) {
       best2 = d2;
       best = std::sqrt(d2);
@@ -135,11 +132,6 @@ double polyline_distance(const std::vector<Vec2>& pts, bool closed, Vec2 q) {
   return point_segment_distance(q, pts[nearest], pts[(nearest + 1) % n]);
 }
 
-double point_segment_distance(Vec2 q, Vec2 a, Vec2 b) {
-  const Vec2 ab = b - a;
-  const double len2 = squared_norm(ab);
-  const double t = len2 > 0.0 ? std::clamp(dot(q - a, ab) / len2, 0.0, 1.0) : 0.0;
-  return distance(q, a + ab * t);
-}
+double point_segment_distance(Vec2 q, Vec2 a, Vec2 b) { return distance(q, a + (b - a) * project_on_segment(q, a, b).t); }
 
 }  // namespace paddock

@@ -1,5 +1,6 @@
 #pragma once
 // polylines and polygons: arc length, resampling, projection, containment, crossings.
+#include <algorithm>
 #include <cstddef>
 #include <optional>
 #include <vector>
@@ -46,6 +47,19 @@ std::optional<double> crossing_right_to_left(Vec2 p0, Vec2 p1, const Segment& g)
 
 // distance from q to the segment a-b
 double point_segment_distance(Vec2 q, Vec2 a, Vec2 b);
+
+// where q projects onto the segment a-b: the fraction t in [0, 1] along it
+// (0 for a point segment) and the squared distance from q to that point
+struct SegmentProjection {
+  double t = 0.0;
+  double distance2 = 0.0;
+};
+inline SegmentProjection project_on_segment(Vec2 q, Vec2 a, Vec2 b) {
+  const Vec2 ab = b - a;
+  const double len2 = squared_norm(ab);
+  const double t = len2 > 0.0 ? std::clamp(dot(q - a, ab) / len2, 0.0, 1.0) : 0.0;
+  return {t, squared_norm(q - (a + ab * t))};
+}
 
 // distance from q to the nearest segment of a polyline (closed: with the
 // segment back to the first point); infinite for fewer than 2 points

@@ -4,6 +4,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "autonomy/common/polyline.h"
+
 namespace paddock {
 
 double Trajectory::wrap(double s) const {
@@ -62,14 +64,11 @@ TrajectoryProjection project(const Trajectory& traj, Vec2 q, double s_hint, doub
     const auto i = static_cast<std::size_t>(((k % m) + m) % m);
     const Vec2 a = traj.points[i].position();
     const Vec2 b = traj.points[(i + 1) % n].position();
-    const Vec2 ab = b - a;
-    const double len2 = squared_norm(ab);
-    const double t = len2 > 0.0 ? std::clamp(dot(q - a, ab) / len2, 0.0, 1.0) : 0.0;
-    const double d2 = squared_norm(q - (a + ab * t));
+    const auto [t, d2] = project_on_segment(q, a, b);
     if (d2 < best_d2) {
       best_d2 = d2;
       best_s = (static_cast<double>(i) + t) * step;
-      best_side = cross(ab, q - a);
+      best_side = cross(b - a, q - a);
     }
   }
   TrajectoryProjection out;

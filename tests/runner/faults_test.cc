@@ -28,6 +28,25 @@ std::vector<sensors::LidarPoint> ring_of_points() {
   return pts;
 }
 
+// a straight 3 m wide track along +x, centreline every 0.5 m; cones every
+// 5 m on both sides, blue left, yellow right
+world::TrackModel straight_track() {
+  world::TrackModel track;
+  for (int i = 0; i <= 200; ++i) {
+    track.centreline.push_back({0.5 * i, 0.0});
+    track.width.push_back(3.0);
+  }
+  return track;
+}
+std::vector<Cone> straight_cones() {
+  std::vector<Cone> cones;
+  for (int i = 0; i < 20; ++i) {
+    cones.push_back({{5.0 * i, 1.5}, ConeColor::Blue});
+    cones.push_back({{5.0 * i, -1.5}, ConeColor::Yellow});
+  }
+  return cones;
+}
+
 TEST(Faults, AWindowIsOnFromAtForItsDuration) {
   FaultWindow w;
   EXPECT_FALSE(w.on(0.0));
@@ -126,17 +145,8 @@ TEST(Faults, TheImuStepAddsItsBiasAndTheNotesNameEveryFault) {
 }
 
 TEST(Faults, TheObjectStandsBesideTheBoundaryAndTheColoursSwapOnTime) {
-  // a straight 3 m wide track along +x, centreline every 0.5 m
-  world::TrackModel track;
-  for (int i = 0; i <= 200; ++i) {
-    track.centreline.push_back({0.5 * i, 0.0});
-    track.width.push_back(3.0);
-  }
-  std::vector<Cone> cones;
-  for (int i = 0; i < 20; ++i) {
-    cones.push_back({{5.0 * i, 1.5}, ConeColor::Blue});
-    cones.push_back({{5.0 * i, -1.5}, ConeColor::Yellow});
-  }
+  const world::TrackModel track = straight_track();
+  std::vector<Cone> cones = straight_cones();
   cones.push_back({{0.0, 3.0}, ConeColor::BigOrange});
   FaultsSection f;
   f.object.at = 2.0;
@@ -180,16 +190,8 @@ TEST(Faults, TheObjectStandsBesideTheBoundaryAndTheColoursSwapOnTime) {
 
 TEST(Faults, TheGustMovesTheConesAroundItsPointOnceInItsDirection) {
   // the straight track along +x; the wind blows to the left of the heading
-  world::TrackModel track;
-  for (int i = 0; i <= 200; ++i) {
-    track.centreline.push_back({0.5 * i, 0.0});
-    track.width.push_back(3.0);
-  }
-  std::vector<Cone> cones;
-  for (int i = 0; i < 20; ++i) {
-    cones.push_back({{5.0 * i, 1.5}, ConeColor::Blue});
-    cones.push_back({{5.0 * i, -1.5}, ConeColor::Yellow});
-  }
+  const world::TrackModel track = straight_track();
+  const std::vector<Cone> cones = straight_cones();
   FaultsSection f;
   f.wind.at = 4.0;
   f.wind.along = 40.0;
