@@ -40,11 +40,11 @@ void drain(ouster::Decoder& d, int rings) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const ouster::SensorInfo& info = shipped();
-  // a fresh decoder per input, copied from one built once (its tables of
-  // the beams' angles cost more than most inputs)
+  // one decoder, reset for each input (its tables of the beams' angles, and
+  // even a copy of them, cost more than most inputs)
   static const paddock::hal::LidarLayout layout = ouster::layout_of(info, paddock::hal::LidarLayout{});
-  static const ouster::Decoder fresh(info, layout);
-  ouster::Decoder d = fresh;
+  static ouster::Decoder d(info, layout);
+  d.reset();
   const int rings = layout.channels;
   std::size_t at = 0;
   while (at + 2 <= size) {

@@ -692,6 +692,18 @@ void Decoder::flush() {
   if (open_) close();
 }
 
+void Decoder::reset() {
+  image_.frame_id = 0;
+  for (auto& col : image_.columns) col.valid = false;
+  open_ = false;
+  received_ = 0;
+  first_ = true;
+  late_run_ = 0;
+  last_closed_ = 0;
+  done_.clear();
+  counters_ = Counters{};
+}
+
 std::optional<LidarScan> Decoder::pop() {
   if (done_.empty()) return std::nullopt;
   LidarScan s = std::move(done_.front());

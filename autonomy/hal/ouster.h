@@ -152,6 +152,9 @@ class Decoder {
   std::optional<LidarScan> pop();
   // end of stream: emits the open rotation (it has a valid column)
   void flush();
+  // forgets the stream (a sensor that restarted, a new log): as just
+  // constructed, without building the angle tables again
+  void reset();
   const Counters& counters() const { return counters_; }
 
   // the points of a rotation: column by column in measurement_id order,

@@ -770,6 +770,33 @@ TEST(OusterAssembly, ColumnWindowCompletesTheRotation) {
   EXPECT_EQ(d.counters().partial_first, 0u);
 }
 
+// a decoder reset in the middle of a rotation (and after a late run and a
+// partial first) decodes the next stream as a new one does, counters and all
+TEST(OusterAssembly, ResetIsANewDecoder) {
+  Stream st;
+  const RangeImage a = st.image(40), b = st.image(41), c = st.image(7), e = st.image(8);
+  const std::vector<Bytes> pa = packets_of(st.info, a), pb = packets_of(st.info, b);
+  Decoder used(st.info, st.layout);
+  for (std::size_t k = 3; k < pa.size(); ++k) used.push(pa[k].data(), pa[k].size());  // a partial first
+  push_all(used, pb);
+  for (std::size_t k = 0; k < 4; ++k) used.push(pa[k].data(), pa[k].size());  // late
+  ASSERT_GT(used.counters().partial_first + used.counters().late_columns, 0u);
+  used.reset();
+  EXPECT_FALSE(used.pop().has_value());  // b's rotation, decoded before the reset, is gone
+  Decoder fresh(st.info, st.layout);
+  for (Decoder* d : {&used, &fresh}) {
+    push_all(*d, packets_of(st.info, c));  // frame 7 after 41: old for the used one unless reset
+    push_all(*d, packets_of(st.info, e));
+    d->flush();
+  }
+  const std::vector<LidarScan> got = drain(used), want = drain(fresh);
+  ASSERT_EQ(got.size(), 2u);
+  ASSERT_EQ(want.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) expect_same(got[k], want[k]);
+  expect_same(got[0], st.scan(c));
+  EXPECT_EQ(std::memcmp(&used.counters(), &fresh.counters(), sizeof(Decoder::Counters)), 0);
+}
+
 TEST(OusterAssembly, FrameIdWrapsAround) {
   Stream st;
   const std::uint16_t frames[] = {65534, 65535, 0, 1};
