@@ -1,6 +1,7 @@
 #include "autonomy/common/polyline.h"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -113,23 +114,129 @@ double polyline_distance(const std::vector<Vec2>& pts, bool closed, Vec2 q) {
   if (n < 2) return std::numeric_limits<double>::infinity();
   // the nearest segment by squared distance (no hypot per segment), then its
   // distance as point_segment_distance gives it
-  double best = std::numeric_limits<double>::infinity(), best2 = best;
+  double best2 = std::numeric_limits<double>::infinity();
   std::size_t nearest = 0;
   for (std::size_t i = 0; i < (closed ? n : n - 1); ++i) {
     const Vec2 a = pts[i], b = pts[(i + 1) % n];
-    // skip segments whose bounding box is farther than the best so far
+    // skip segments whose bounding box is clearly farther than the best so
+    // far (the margin: never one the rounding of d2 could still make nearer)
     const double dx = std::max({std::min(a.x, b.x) - q.x, q.x - std::max(a.x, b.x), 0.0});
     const double dy = std::max({std::min(a.y, b.y) - q.y, q.y - std::max(a.y, b.y), 0.0});
-    if (dx >= best || dy >= best) continue;
+    if (dx * dx + dy * dy > best2 * (1.0 + 1e-9)) continue;
     const double d2 = project_on_segment(q, a, b).distance2;
     if (d2 < best2) {
       best2 = d2;
-      best = std::sqrt(d2);
       nearest = i;
     }
   }
   if (best2 == std::numeric_limits<double>::infinity()) return best2;  // none compared (e.g. q not finite)
   return point_segment_distance(q, pts[nearest], pts[(nearest + 1) % n]);
+}
+
+namespace {
+constexpr std::size_t kMaxCellsPerSegment = 16;  // more: a long segment
+}
+
+PolylineIndex::PolylineIndex(std::vector<Vec2> pts, bool closed) : pts_(std::move(pts)), closed_(closed) {
+  const std::size_t n = pts_.size();
+  if (n < 2) return;
+  segments_ = closed_ ? n : n - 1;
+  Vec2 lo = pts_[0], hi = pts_[0];
+  double length = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(pts_[i].x) || !std::isfinite(pts_[i].y)) return;  // no grid: brute force
+    lo = {std::min(lo.x, pts_[i].x), std::min(lo.y, pts_[i].y)};
+    hi = {std::max(hi.x, pts_[i].x), std::max(hi.y, pts_[i].y)};
+  }
+  for (std::size_t i = 0; i < segments_; ++i) length += paddock::distance(pts_[i], pts_[(i + 1) % n]);
+  if (segments_ < 8 || !(length > 0.0) || !std::isfinite(length)) return;
+  // cells of about a segment's mean length, at most ~4 per segment
+  const double w = hi.x - lo.x, h = hi.y - lo.y;
+  double cell = std::max(length / static_cast<double>(segments_), std::sqrt(w * h / (4.0 * static_cast<double>(segments_))));
+  cell = std::max(cell, std::max(w, h) / 4096.0);
+  if (!(cell > 0.0) || !std::isfinite(cell)) return;
+  cell_ = cell;
+  origin_ = lo;
+  nx_ = static_cast<long>(w / cell) + 1;
+  ny_ = static_cast<long>(h / cell) + 1;
+  auto cell_of = [&](double v, double o, long count) {
+    return std::clamp(static_cast<long>(std::floor((v - o) / cell_)), 0L, count - 1);
+  };
+  // two passes (count, then fill) into one array of cells' segment lists
+  std::vector<std::array<long, 4>> box(segments_);
+  first_.assign(static_cast<std::size_t>(nx_ * ny_) + 1, 0);
+  for (std::size_t i = 0; i < segments_; ++i) {
+    const Vec2 a = pts_[i], b = pts_[(i + 1) % n];
+    box[i] = {cell_of(std::min(a.x, b.x), lo.x, nx_), cell_of(std::max(a.x, b.x), lo.x, nx_),
+              cell_of(std::min(a.y, b.y), lo.y, ny_), cell_of(std::max(a.y, b.y), lo.y, ny_)};
+    const auto cells = static_cast<std::size_t>((box[i][1] - box[i][0] + 1) * (box[i][3] - box[i][2] + 1));
+    if (cells > kMaxCellsPerSegment) {
+      long_.push_back(i);
+      box[i][0] = -1;
+      continue;
+    }
+    for (long y = box[i][2]; y <= box[i][3]; ++y)
+      for (long x = box[i][0]; x <= box[i][1]; ++x) ++first_[static_cast<std::size_t>(y * nx_ + x) + 1];
+  }
+  for (std::size_t c = 1; c < first_.size(); ++c) first_[c] += first_[c - 1];
+  in_cell_.resize(first_.back());
+  std::vector<std::size_t> fill(first_.begin(), first_.end() - 1);
+  for (std::size_t i = 0; i < segments_; ++i) {
+    if (box[i][0] < 0) continue;
+    for (long y = box[i][2]; y <= box[i][3]; ++y)
+      for (long x = box[i][0]; x <= box[i][1]; ++x) in_cell_[fill[static_cast<std::size_t>(y * nx_ + x)]++] = i;
+  }
+}
+
+double PolylineIndex::distance(Vec2 q) const {
+  if (segments_ == 0) return std::numeric_limits<double>::infinity();
+  const std::size_t n = pts_.size();
+  const double fx = std::floor((q.x - origin_.x) / cell_), fy = std::floor((q.y - origin_.y) / cell_);
+  // no grid, or a query too far from it for cell numbers: every segment
+  if (cell_ == 0.0 || !(std::abs(fx) < 1e9) || !(std::abs(fy) < 1e9)) return polyline_distance(pts_, closed_, q);
+  double best2 = std::numeric_limits<double>::infinity();
+  std::size_t nearest = 0;
+  auto consider = [&](std::size_t i) {
+    const double d2 = project_on_segment(q, pts_[i], pts_[(i + 1) % n]).distance2;
+    if (d2 < best2 || (d2 == best2 && i < nearest)) {
+      best2 = d2;
+      nearest = i;
+    }
+  };
+  for (std::size_t i : long_) consider(i);
+  const auto cx = static_cast<long>(fx), cy = static_cast<long>(fy);
+  // rings of cells at Chebyshev distance r from q's: from the first that
+  // meets the grid to the last, while a cell of the ring can be nearer than
+  // the best (its points are at least (r - 1) cells away)
+  const long r_first = std::max({0L, -cx, cx - (nx_ - 1), -cy, cy - (ny_ - 1)});
+  const long r_last = std::max({std::abs(cx), std::abs(cx - (nx_ - 1)), std::abs(cy), std::abs(cy - (ny_ - 1))});
+  auto visit = [&](long x, long y) {
+    if (x < 0 || x >= nx_ || y < 0 || y >= ny_) return;
+    const auto c = static_cast<std::size_t>(y * nx_ + x);
+    for (std::size_t k = first_[c]; k < first_[c + 1]; ++k) consider(in_cell_[k]);
+  };
+  for (long r = r_first; r <= r_last; ++r) {
+    if (best2 != std::numeric_limits<double>::infinity()) {
+      const double gap = static_cast<double>(r - 1) * cell_;
+      if (gap > 0.0 && gap * gap > best2 * (1.0 + 1e-9)) break;
+    }
+    if (r == 0) {
+      visit(cx, cy);
+      continue;
+    }
+    const long x0 = std::max(cx - r, 0L), x1 = std::min(cx + r, nx_ - 1);
+    for (long x = x0; x <= x1; ++x) {
+      visit(x, cy - r);
+      visit(x, cy + r);
+    }
+    const long y0 = std::max(cy - r + 1, 0L), y1 = std::min(cy + r - 1, ny_ - 1);
+    for (long y = y0; y <= y1; ++y) {
+      visit(cx - r, y);
+      visit(cx + r, y);
+    }
+  }
+  if (best2 == std::numeric_limits<double>::infinity()) return best2;
+  return point_segment_distance(q, pts_[nearest], pts_[(nearest + 1) % n]);
 }
 
 double point_segment_distance(Vec2 q, Vec2 a, Vec2 b) { return distance(q, a + (b - a) * project_on_segment(q, a, b).t); }

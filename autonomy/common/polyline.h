@@ -62,7 +62,31 @@ inline SegmentProjection project_on_segment(Vec2 q, Vec2 a, Vec2 b) {
 }
 
 // distance from q to the nearest segment of a polyline (closed: with the
-// segment back to the first point); infinite for fewer than 2 points
+// segment back to the first point); infinite for fewer than 2 points. The
+// nearest segment is the one of least squared distance (project_on_segment),
+// the lowest index of equals
 double polyline_distance(const std::vector<Vec2>& pts, bool closed, Vec2 q);
+
+// many polyline_distance queries to one polyline: its segments in a uniform
+// grid, searched in rings of cells outward from the query's until no nearer
+// segment can remain; distance(q) equals polyline_distance(pts, closed, q)
+// bit for bit (the same nearest segment). A segment whose box spans many
+// cells (a polyline of few long segments) is checked on every query instead.
+class PolylineIndex {
+ public:
+  PolylineIndex(std::vector<Vec2> pts, bool closed);
+  double distance(Vec2 q) const;
+
+ private:
+  std::vector<Vec2> pts_;
+  bool closed_ = false;
+  std::size_t segments_ = 0;
+  Vec2 origin_;            // the grid's lower left corner
+  double cell_ = 0.0;      // m, a cell's side (0: no grid, every query brute force)
+  long nx_ = 0, ny_ = 0;   // cells across, up
+  std::vector<std::size_t> first_;  // per cell: its segments are in_cell_[first_[c] .. first_[c + 1])
+  std::vector<std::size_t> in_cell_;
+  std::vector<std::size_t> long_;   // the segments checked on every query
+};
 
 }  // namespace paddock

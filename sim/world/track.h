@@ -42,6 +42,10 @@ inline constexpr double kDoubledConeDistance = 0.05;  // m
 // hundred; a file of millions is no track, and checking it for doubled cones
 // would take hours
 inline constexpr std::size_t kMaxTrackCones = 10000;
+// the farthest a cone, the start or a timekeeping post may lie from the first
+// cone: the shipped tracks span at most 170 m; a file spread over kilometres
+// is no track (and would make a centreline of millions of points)
+inline constexpr double kMaxTrackSpan = 5000.0;  // m
 
 // the content of one track file, as written
 struct TrackFile {
@@ -58,7 +62,8 @@ struct TrackFile {
 
 // parse the text of a track file; `source` names it in messages. Throws
 // TrackError (also for a file of more than kMaxTrackCones cones, at its first
-// cone too many).
+// cone too many, and for one spread wider than kMaxTrackSpan, at the first
+// line beyond it).
 TrackFile parse_track(std::string_view text, const std::string& source);
 
 enum class TrackKind { Circuit, Acceleration, Skidpad };

@@ -143,7 +143,8 @@ void build_acceleration(TrackModel& m, const TrackFile& f, const ConeSets& cs) {
   // centreline: the axis from the start to the end of the layout
   const std::vector<Vec2> axis{o + u * a_start, o + u * a_max};
   m.centreline = resample(axis, false, kCentrelineSpacing);
-  for (const Vec2& q : m.centreline) m.width.push_back(polyline_distance(lside, false, q) + polyline_distance(rside, false, q));
+  const PolylineIndex left_index(lside, false), right_index(rside, false);
+  for (const Vec2& q : m.centreline) m.width.push_back(left_index.distance(q) + right_index.distance(q));
 
   std::vector<Vec2> polygon = lside;
   polygon.insert(polygon.end(), rside.rbegin(), rside.rend());

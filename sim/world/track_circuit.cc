@@ -325,14 +325,15 @@ Centre centre_between(const std::vector<Vec2>& left, const std::vector<Vec2>& ri
   std::vector<Vec2> c = resample(guess, closed, kCentrelineSpacing);
 
   // move each point along its normal to where both boundaries are equally far
+  const PolylineIndex left_index(left, closed), right_index(right, closed);
   for (int round = 0; round < 6; ++round) {
     for (int it = 0; it < 3; ++it) {
       std::vector<Vec2> moved = c;
       for (std::size_t i = 0; i < c.size(); ++i) {
         if (!closed && (i == 0 || i + 1 == c.size())) continue;
         const Vec2 n = left_normal(tangent_at(c, closed, i));
-        const double dl = polyline_distance(left, closed, c[i]);
-        const double dr = polyline_distance(right, closed, c[i]);
+        const double dl = left_index.distance(c[i]);
+        const double dr = right_index.distance(c[i]);
         moved[i] = c[i] + n * (0.5 * (dl - dr));
       }
       c.swap(moved);
@@ -354,7 +355,7 @@ Centre centre_between(const std::vector<Vec2>& left, const std::vector<Vec2>& ri
   out.line = c;
   for (std::size_t i = 0; i < c.size(); ++i) {
     const Vec2 n = left_normal(tangent_at(c, closed, i));
-    const double dl = polyline_distance(left, closed, c[i]), dr = polyline_distance(right, closed, c[i]);
+    const double dl = left_index.distance(c[i]), dr = right_index.distance(c[i]);
     double wl = ray_hit(left, closed, c[i], n), wr = ray_hit(right, closed, c[i], -n);
     if (wl > 2.0 * dl + 0.5) wl = dl;
     if (wr > 2.0 * dr + 0.5) wr = dr;

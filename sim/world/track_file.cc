@@ -128,6 +128,30 @@ void find_doubles(TrackFile& f) {
 
 }  // namespace
 
+namespace {
+
+// every cone, the start and the timekeeping posts within kMaxTrackSpan of the
+// first cone: else the first line (in the file) of one that is not
+void check_span(const TrackFile& f) {
+  const Vec2 first = f.cones.front().position;
+  int worst_line = 0;
+  std::string what;
+  auto consider = [&](Vec2 p, int line, const char* kind) {
+    const double d = distance(p, first);
+    if (d <= kMaxTrackSpan || (worst_line != 0 && line >= worst_line)) return;
+    worst_line = line;
+    what = std::string(kind) + " at (" + fixed(p.x, 1) + ", " + fixed(p.y, 1) + ") is " + fixed(d / 1000.0, 1) +
+           " km from the first cone (line " + std::to_string(f.cone_lines.front()) + "), expected every cone, the start and the posts within " +
+           fixed(kMaxTrackSpan / 1000.0, 0) + " km of it (a Formula Student track spans a few hundred metres)";
+  };
+  for (std::size_t i = 0; i < f.cones.size(); ++i) consider(f.cones[i].position, f.cone_lines[i], "cone");
+  if (f.start) consider({f.start->x, f.start->y}, f.start_line, "'# start'");
+  for (std::size_t i = 0; i < f.timekeeping.size(); ++i) consider(f.timekeeping[i], f.timekeeping_lines[i], "'# timekeeping' post");
+  if (worst_line != 0) fail(f.source, worst_line, what);
+}
+
+}  // namespace
+
 TrackFile parse_track(std::string_view text, const std::string& source) {
   TrackFile f;
   f.source = source;
@@ -192,6 +216,7 @@ TrackFile parse_track(std::string_view text, const std::string& source) {
          "'# timekeeping' post without a partner: posts come in pairs (one gate per pair), found " +
              std::to_string(f.timekeeping.size()));
   }
+  check_span(f);
   find_doubles(f);
   return f;
 }

@@ -640,6 +640,12 @@ TEST(Parse, MoreErrors) {
   EXPECT_THAT(error("tag,x,y\nBlue,1,2\n"), StartsWith("t.csv:2: unknown cone tag 'Blue'"));
   EXPECT_THAT(error(""), StartsWith("t.csv:1: missing header row"));
   EXPECT_THAT(error("# only comments\n"), StartsWith("t.csv:1: missing header row"));
+  // spread over kilometres: the first line beyond kMaxTrackSpan of the first cone
+  EXPECT_THAT(error("tag,x,y\nblue,100,0\nyellow,4000,3000\nblue,4100,3100\nblue,-5000,0\n"),
+              StartsWith("t.csv:4: cone at (4100.0, 3100.0) is 5.1 km from the first cone (line 2)"));
+  EXPECT_THAT(error("# timekeeping 0 1\n# timekeeping 0 9000\ntag,x,y\nblue,0,0\n"), StartsWith("t.csv:2: '# timekeeping' post at (0.0, 9000.0)"));
+  EXPECT_THAT(error("tag,x,y\nblue,0,0\n# start 1e6 0 0\n"), StartsWith("t.csv:3: '# start' at (1000000.0, 0.0) is 1000.0 km"));
+  EXPECT_EQ(error("tag,x,y\nblue,100,0\nyellow,4100,3000\n"), "(no error)");  // 5 km exactly: kept
 }
 
 TEST(Build, LayoutsThatMakeNoSenseNameTheSource) {
