@@ -87,10 +87,7 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
                                [](const IniEntry& e) { return e.section == "hal" && e.key == "lidar_metadata"; }),
                 entries.end());
   const Scenario scenario = load_scenario_entries(std::move(entries), attached("scenario.ini"), overrides, &table);
-  const auto track_text = table.find(scenario.scenario.track);
-  const world::TrackModel track = world::build_track(track_text != table.end()
-                                                         ? world::parse_track(track_text->second, scenario.scenario.track)
-                                                         : load_track_file(scenario.track_path));
+  const world::TrackModel track = world::build_track(load_track_file(scenario.track_path, &table));
   const SimModel model = compile_model(scenario, track);
 
   // the car: its decoders, its stack and its watchdogs, as the car binary has them

@@ -183,12 +183,7 @@ void require_given(const std::vector<Key>& keys, const Given& given, const std::
 // sets may be given only with the file's value), the DBC is parsed and
 // checked against what the car sends; wire needs both where they are used
 void load_hal_files(Scenario& s, const std::vector<IniEntry>& entries, const std::string& path, const FileTable* files) {
-  const auto read = [files](const std::string& file) {
-    if (files) {
-      if (const auto it = files->find(file); it != files->end()) return it->second;
-    }
-    return read_file(file);
-  };
+  const auto read = [files](const std::string& file) { return read_input(file, files); };
   if (!s.hal.lidar_metadata.empty()) {
     const std::string& file = s.hal.lidar_metadata;
     try {
@@ -342,8 +337,15 @@ std::string resolved_ini(const Scenario& scenario) {
 
 namespace paddock::runner {
 
-world::TrackFile load_track_file(const std::string& path) {
-  return world::parse_track(read_file(path), path);
+std::string read_input(const std::string& path, const FileTable* files) {
+  if (files) {
+    if (const auto it = files->find(path); it != files->end()) return it->second;
+  }
+  return read_file(path);
+}
+
+world::TrackFile load_track_file(const std::string& path, const FileTable* files) {
+  return world::parse_track(read_input(path, files), path);
 }
 
 std::uint64_t stream_seed(std::uint64_t scenario_seed, std::string_view stream) {

@@ -272,9 +272,13 @@ estimation::CarGeometry car_geometry(const vehicle::VehicleParams& v, const sens
 // loadable again to the same Scenario
 std::string resolved_ini(const Scenario& s);
 
-// reads and parses a track file; throws UserError "path: cannot open ..." or
-// world::TrackError "path:line: ..."
-world::TrackFile load_track_file(const std::string& path);
+// a file's text: from `files` when it holds `path`, else from disk
+// (read_file: UserError "path: cannot open ...")
+std::string read_input(const std::string& path, const FileTable* files);
+
+// reads (as read_input) and parses a track file; throws UserError "path:
+// cannot open ..." or world::TrackError "path:line: ..."
+world::TrackFile load_track_file(const std::string& path, const FileTable* files = nullptr);
 
 // the seed of one named random stream of a run: every random draw of a run
 // comes from the scenario's seed through this function. The streams:
