@@ -210,12 +210,21 @@ double PolylineIndex::distance(Vec2 q) const {
   // the best (its points are at least (r - 1) cells away)
   const long r_first = std::max({0L, -cx, cx - (nx_ - 1), -cy, cy - (ny_ - 1)});
   const long r_last = std::max({std::abs(cx), std::abs(cx - (nx_ - 1)), std::abs(cy), std::abs(cy - (ny_ - 1))});
+  // a query far from the polyline for its cells' size (a track whose width
+  // is a hundred cone spacings) would visit more cells than there are
+  // segments: past that, every segment is checked instead
+  std::size_t visited = 0;
   auto visit = [&](long x, long y) {
     if (x < 0 || x >= nx_ || y < 0 || y >= ny_) return;
+    ++visited;
     const auto c = static_cast<std::size_t>(y * nx_ + x);
     for (std::size_t k = first_[c]; k < first_[c + 1]; ++k) consider(in_cell_[k]);
   };
   for (long r = r_first; r <= r_last; ++r) {
+    if (visited > segments_) {
+      for (std::size_t i = 0; i < segments_; ++i) consider(i);
+      break;
+    }
     if (best2 != std::numeric_limits<double>::infinity()) {
       const double gap = static_cast<double>(r - 1) * cell_;
       if (gap > 0.0 && gap * gap > best2 * (1.0 + 1e-9)) break;
