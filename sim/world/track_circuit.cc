@@ -283,7 +283,19 @@ void smooth(std::vector<Vec2>& p, bool closed, double lambda, int iterations) {
   }
 }
 
-Centre centre_between(const std::vector<Vec2>& left, const std::vector<Vec2>& right, bool closed) {
+// source names the file in the error of a centreline that does not settle
+Centre centre_between(const std::vector<Vec2>& left, const std::vector<Vec2>& right, bool closed, const std::string& source) {
+  // a centreline runs between its boundaries: longer than both together, it
+  // is swinging from side to side (a layout with no track between its two
+  // boundaries), and would only grow with every round
+  const double longest = polyline_length(left, closed) + polyline_length(right, closed);
+  auto settled = [&](const std::vector<Vec2>& line, int round) {
+    const double length = polyline_length(line, closed);
+    if (length > longest + 100.0)
+      throw TrackError(source + ": the centreline does not settle between the boundaries (" + fixed(length, 0) +
+                       " m after round " + std::to_string(round) + ", the boundaries " + fixed(longest, 0) +
+                       " m together): the cones do not make a track");
+  };
   // first guess: each dense left sample paired with the nearest right point,
   // searched in a window that moves forward with the samples
   const auto dense = resample(left, closed, kDenseSpacing);
@@ -339,6 +351,7 @@ Centre centre_between(const std::vector<Vec2>& left, const std::vector<Vec2>& ri
       c.swap(moved);
     }
     smooth(c, closed, 0.5, 2);
+    settled(c, round + 1);
     c = resample(c, closed, kCentrelineSpacing);
   }
   // a last smoothing takes the corners of the medial line off (it moves the
@@ -431,7 +444,7 @@ void build_circuit(TrackModel& m, const TrackFile& f, const ConeSets& cs) {
     }
   }
 
-  Centre c = centre_between(m.left, m.right, true);
+  Centre c = centre_between(m.left, m.right, true, f.source);
   Arc arc{&c.line, true, polyline_length(c.line, true)};
 
   // gates: timekeeping posts, else big orange cones, else a line across the track

@@ -30,6 +30,7 @@ TrackFile load_track_file(const std::string& path) {
 }
 
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 using ::testing::StartsWith;
 
@@ -665,6 +666,16 @@ TEST(Build, LayoutsThatMakeNoSenseNameTheSource) {
   }
   const TrackFile c = parse_track(text, "c.csv");
   EXPECT_THAT([&] { build_track(c); }, ::testing::ThrowsMessage<TrackError>(HasSubstr("c.csv: cannot order")));
+}
+
+// found by the fuzzer: a real track's 82 blue cones around 4 yellow ones
+// hundreds of metres apart. The centreline swung from side to side and grew
+// to 3,680 km (7.4 million points, 10 s) before its length was checked
+TEST(Build, ACentrelineThatDoesNotSettleIsRefused) {
+  const TrackFile f = load_track_file(kBad + "/no_settle.csv");
+  EXPECT_THAT([&] { build_track(f); },
+              ::testing::ThrowsMessage<TrackError>(AllOf(StartsWith(kBad + "/no_settle.csv: the centreline does not settle"),
+                                                         HasSubstr("the cones do not make a track"))));
 }
 
 
