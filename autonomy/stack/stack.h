@@ -10,6 +10,7 @@
 
 #include "autonomy/common/geometry.h"
 #include "autonomy/common/params.h"
+#include "autonomy/common/profile.h"
 #include "autonomy/common/time.h"
 #include "autonomy/common/trajectory.h"
 #include "autonomy/control/controller.h"
@@ -234,6 +235,9 @@ class Stack {
   // how many frames came so far: for the perception metrics
   const hal::ConeDetections& last_detections() const { return last_detections_; }
   long detection_frames() const { return detection_frames_; }
+  // where the stack's time goes, by stage (perception, localisation,
+  // planning, control), timed into `profile` from now on; null: not timed
+  void set_profile(Profile* profile) { profile_ = profile; }
 
  private:
   void on_message(hal::SensorMessage&& m);
@@ -273,6 +277,7 @@ class Stack {
   Trajectory trajectory_;
   control::Controller controller_;
   Telemetry telemetry_;
+  Profile* profile_ = nullptr;
   std::unique_ptr<perception::Perception> perception_;
 
   // slam != ground_truth: the stack's own estimate, from the HAL's sensors

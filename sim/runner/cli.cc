@@ -37,7 +37,7 @@ namespace {
 const char* kUsage =
     "usage:\n"
     "  paddock run SCENARIO.ini [--set section.key=value]... [--out DIR] [--json] [--quiet] [--log]\n"
-    "              [--plots [PLOT OPTIONS]]\n"
+    "              [--profile] [--plots [PLOT OPTIONS]]\n"
     "      runs a scenario headless and prints the result; writes DIR/summary.json,\n"
     "      DIR/scenario.ini (resolved, defaults included) and DIR/log.csv\n"
     "      (DIR defaults to runs/<scenario name> in the current folder). --json prints\n"
@@ -45,6 +45,9 @@ const char* kUsage =
     "      draws the figures;\n"
     "      --log writes DIR/run.mcap (a wire run: the LiDAR's packets, the CAN frames,\n"
     "      the stack's outputs in Foxglove's schemas).\n"
+    "      --profile prints where the wall time went, by stage (physics, lidar,\n"
+    "      camera, perception, localisation, planning, control, logging, scoring,\n"
+    "      other; also in summary.json's \"profile\" always).\n"
     "      Exit 3 when [expect] fails.\n"
     "  paddock bench-compare OLD.json NEW.json   (./paddock bench compare OLD.json NEW.json)\n"
     "      two runs of the benchmarks (./paddock bench --json FILE) side by side: each\n"
@@ -171,7 +174,7 @@ bool plot_option(const std::vector<std::string>& args, std::size_t& i, PlotOptio
 int cmd_run(const std::vector<std::string>& args) {
   std::string scenario_path, out_dir;
   std::vector<std::string> overrides;
-  bool json = false, quiet = false, plots = false, log = false;
+  bool json = false, quiet = false, plots = false, log = false, profile = false;
   PlotOptions plot_options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -187,6 +190,7 @@ int cmd_run(const std::vector<std::string>& args) {
     else if (a == "--json") json = true;
     else if (a == "--quiet") quiet = true;
     else if (a == "--log") log = true;
+    else if (a == "--profile") profile = true;
     else if (!a.empty() && a[0] == '-') throw UserError("unknown option " + a + "\n" + kUsage);
     else if (scenario_path.empty()) scenario_path = a;
     else throw UserError("more than one scenario given: " + scenario_path + " and " + a);
@@ -247,6 +251,7 @@ int cmd_run(const std::vector<std::string>& args) {
     std::cout << summary_text(scenario, result, failed) << "  output      " << out_dir << "/\n";
     for (const auto& f : figures) std::cout << "  figure      " << f << "\n";
   }
+  if (profile && !json) std::cout << "\nwhere the wall time went (--profile):\n" << profile_text(result);
   return failed.empty() ? 0 : 3;
 }
 

@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "autonomy/common/profile.h"
 #include "autonomy/hal/messages.h"
 #include "sim/runner/faults.h"
 #include "sim/runner/sim_hal.h"
@@ -73,8 +74,11 @@ class RawSensors {
   TimeNs scan_end(TimeNs now) const;
   // the last camera frame rendered (for the perception figures), or null
   const hal::CameraFrame* camera_frame() const { return camera_ && frame_.width > 0 ? &frame_ : nullptr; }
+  // the LiDAR's and the camera's time, timed into `profile` (null: not timed)
+  void set_profile(Profile* profile) { profile_ = profile; }
 
  private:
+  Profile* profile_ = nullptr;
   // the cones as they stand (in the colours the faults give them at t) and
   // the blocks (the venue's and a fault's object): rebuilt when they changed
   void update_scene(const world::ConeWorld& cones, const FaultInjector& faults, double t);

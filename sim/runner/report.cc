@@ -5,6 +5,7 @@
 #include <limits>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <algorithm>
 #include <sstream>
 
 #include "autonomy/common/format.h"
@@ -275,6 +276,26 @@ nlohmann::json slam_json(const Scenario& s, const SlamMetrics& m) {
 }
 }  // namespace
 
+std::string profile_text(const RunResult& r) {
+  // the stages by their share, largest first; per simulated second the
+  // wall milliseconds each costs (its share of the real-time factor)
+  std::vector<Stage> order;
+  for (std::size_t i = 0; i < kStageCount; ++i) order.push_back(static_cast<Stage>(i));
+  std::stable_sort(order.begin(), order.end(),
+                   [&r](Stage a, Stage b) { return r.profile.seconds(a) > r.profile.seconds(b); });
+  const double total = r.profile.total();
+  std::ostringstream o;
+  o << "| stage | wall s | share | ms per simulated s |\n|---|---:|---:|---:|\n";
+  for (Stage st : order) {
+    const double sec = r.profile.seconds(st);
+    o << "| " << stage_name(st) << " | " << fixed(sec, 3) << " | " << fixed(total > 0 ? 100.0 * sec / total : 0.0, 1)
+      << " % | " << fixed(r.sim_time > 0 ? 1000.0 * sec / r.sim_time : 0.0, 2) << " |\n";
+  }
+  o << "| total | " << fixed(total, 3) << " | 100.0 % | " << fixed(r.sim_time > 0 ? 1000.0 * total / r.sim_time : 0.0, 2)
+    << " |\n";
+  return o.str();
+}
+
 std::string summary_json(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed) {
   using Json = nlohmann::ordered_json;
   const auto& ev = r.event;
@@ -341,6 +362,12 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
            {"rules_distance", ebs_rules_distance(r.ebs.speed)},
            {"within_rules", r.ebs.stopped_at.has_value() && r.ebs.distance <= ebs_rules_distance(r.ebs.speed)}};
   }
+  // wall seconds per stage (profile.h), in the stages' order
+  Json profile = Json::object();
+  for (std::size_t i = 0; i < kStageCount; ++i) {
+    const auto stage = static_cast<Stage>(i);
+    profile[std::string(stage_name(stage))] = r.profile.seconds(stage);
+  }
   // JSON has no NaN or infinity: nlohmann writes them as null
   const Json j = {
       {"scenario", s.name},
@@ -357,6 +384,7 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"sim_time", r.sim_time},
       {"wall_time", r.wall_time},
       {"realtime_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0},
+      {"profile", profile},
       {"tracking", r.stack_remote ? Json(nullptr) : tracking(r.tracking.rms, r.tracking.max, r.tracking.itae)},
       {"energy", r.energy},
       {"slam", r.stack_remote ? Json(nullptr) : Json(slam_json(s, r.slam))},

@@ -19,6 +19,10 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
 // one JSON object (schema in the README)
 std::string summary_json(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed);
 
+// `run --profile`: the run's wall time by stage (profile.h) as a Markdown
+// table, the largest first: seconds, share, milliseconds per simulated second
+std::string profile_text(const RunResult& r);
+
 // the stack's last plan and map (plan.json): the map's optional layers
 std::string plan_json(const RunResult& r);
 

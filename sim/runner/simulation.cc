@@ -227,6 +227,25 @@ std::unique_ptr<WireLink> make_wire(const Scenario& sc) {
   return wire;
 }
 
+// the run's MCAP log (the HAL's traffic it is handed), timed as logging
+struct TimedTap final : WireTap {
+  explicit TimedTap(WireTap* inner_tap) : inner(inner_tap) {}
+  void lidar_packet(TimeNs at, const std::uint8_t* data, std::size_t size) override {
+    const StageScope timed(profile, Stage::Logging);
+    inner->lidar_packet(at, data, size);
+  }
+  void can_frame(TimeNs at, bool to_stack, const std::uint8_t* frame) override {
+    const StageScope timed(profile, Stage::Logging);
+    inner->can_frame(at, to_stack, frame);
+  }
+  void message(TimeNs at, const hal::SensorMessage& m) override {
+    const StageScope timed(profile, Stage::Logging);
+    inner->message(at, m);
+  }
+  WireTap* inner;
+  Profile* profile = nullptr;
+};
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -251,12 +270,15 @@ SimState::SimState(const SimModel& model, WireTap* tap)
       steering(model.scenario.steering_sensor, stream_seed(model.scenario.scenario.seed, "steering_sensor")),
       true_poses(model.pose_history_span) {
   hal.set_tap(tap);
+  stack.set_profile(&profile);
+  if (raw) raw->set_profile(&profile);
   faults.place(model.track, model.cones);
   run_due(model, *this);
 }
 
 void step(const SimModel& model, SimState& s) {
   // physics: the car, the cones it may hit, the timing gates
+  const StageScope physics(&s.profile, Stage::Physics);
   const vehicle::VehicleParams& car = model.scenario.vehicle;
   const double nose_x = model.footprint.x_max;
   const Vec2 nose0 = vehicle::base_pose(car, s.car).transform({nose_x, 0.0});
@@ -292,6 +314,7 @@ void step(const SimModel& model, SimState& s) {
   s.now = s.k * model.dt_ns;
   s.t = static_cast<double>(s.k) * model.dt;
   s.event.on_motion(t0, nose0, t0 + model.dt, base.transform({nose_x, 0.0}));
+  const StageScope outside(&s.profile, Stage::Other);  // what falls due times itself
   run_due(model, s);
 }
 
@@ -312,18 +335,28 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
     });
   }
   const SimModel model = compile_model(scenario, track);
-  SimState state(model, tap);
+  TimedTap timed_tap(tap);
+  SimState state(model, tap ? &timed_tap : nullptr);
+  timed_tap.profile = &state.profile;
   LogRecorder log;
   PerceptionScorer scorer;
   SlamScorer slam;
   SnapshotRecorder snapshot;
   Observer* const observers[] = {&snapshot, &scorer, &slam, &log};
+  state.profile.start();
   for (;;) {
-    for (Observer* o : observers) o->observe(model, state);
-    for (Observer* o : extra) o->observe(model, state);
+    for (Observer* o : observers) {
+      const StageScope timed(&state.profile, o == &log ? Stage::Logging : Stage::Scoring);
+      o->observe(model, state);
+    }
+    for (Observer* o : extra) {
+      const StageScope timed(&state.profile, Stage::Logging);  // the caller's: a run's MCAP log
+      o->observe(model, state);
+    }
     if (state.done) break;
     step(model, state);
   }
+  state.profile.stop();
 
   RunResult result = results_of(state);
   result.stack_remote = state.hal.remote();
@@ -339,6 +372,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
   result.snapshot = std::move(snapshot.snapshot());
   if (limit.valid()) result.limit = limit.get();
   if (result.limit) result.limit_lap = result.limit->min_curvature.lap_time;
+  result.profile = state.profile;
   result.wall_time = seconds_since(wall0);
   return result;
 }

@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "autonomy/common/profile.h"
 #include "autonomy/stack/stack.h"
 #include "sim/events/event.h"
 #include "sim/runner/faults.h"
@@ -115,6 +116,10 @@ struct SimState {
   // LiDAR hit them, or the cone sensor had them in view unoccluded)
   PoseHistory true_poses;
   std::deque<std::pair<TimeNs, std::vector<bool>>> visible;
+
+  // where the wall time goes, by stage: the physics, the sensors and the
+  // stack time themselves into it (run() starts it; untimed until then)
+  Profile profile;
 };
 
 // advances the state one physics step (the car, the cones it may hit, the
@@ -173,6 +178,8 @@ struct RunResult {
   // when they cannot be built
   std::optional<LimitLines> limit;
   std::optional<double> limit_lap;
+  // the run's wall time by stage (a measurement of the machine, as wall_time)
+  Profile profile;
 };
 
 // runs one scenario to its end (finish or DNF); deterministic for a given

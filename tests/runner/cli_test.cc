@@ -102,6 +102,7 @@ std::string without_wall_clock(std::string json) {
   json = std::regex_replace(json, std::regex("\"wall_time\":[^,]*,"), "");
   json = std::regex_replace(json, std::regex("\"update_ms_mean\":[^,]*,"), "");
   json = std::regex_replace(json, std::regex("\"update_ms_p99\":[^,]*,"), "");
+  json = std::regex_replace(json, std::regex("\"profile\":\\{[^}]*\\},"), "");
   return std::regex_replace(json, std::regex("\"realtime_factor\":[^,]*,"), "");
 }
 
@@ -187,6 +188,32 @@ TEST(Cli, JsonSummaryCarriesTheSchema) {
   const auto acc = paddock("run " + kRoot + "/scenarios/acceleration.ini --json --out " + scratch("json_acc"));
   ASSERT_EQ(acc.code, 0) << acc.output;
   EXPECT_TRUE(nlohmann::json::parse(acc.output)["limit_lap_s"].is_null());
+}
+
+// --profile: the stages' table; summary.json's "profile" has every stage,
+// none negative, their sum within the run's wall time (the stages and
+// "other" partition the closed loop's time, which the wall time includes)
+TEST(Cli, ProfileSaysWhereTheWallTimeWent) {
+  const auto o = paddock("run " + kRoot + "/scenarios/acceleration.ini --profile --out " +
+                         scratch("profile"));
+  ASSERT_EQ(o.code, 0) << o.output;
+  EXPECT_THAT(o.output, HasSubstr("where the wall time went (--profile):\n| stage | wall s | share | ms per simulated s |"));
+  const auto j = nlohmann::json::parse(paddock::runner::read_file(scratch("profile") + "/summary.json"));
+  double sum = 0.0;
+  for (const char* stage : {"other", "physics", "lidar", "camera", "perception", "localisation", "planning", "control",
+                            "logging", "scoring"}) {
+    ASSERT_TRUE(j["profile"][stage].is_number()) << stage;
+    const double s = j["profile"][stage].get<double>();
+    EXPECT_GE(s, 0.0) << stage;
+    sum += s;
+    EXPECT_THAT(o.output, HasSubstr(std::string("\n| ") + stage + " | ")) << stage;
+  }
+  EXPECT_EQ(j["profile"].size(), 10u);
+  EXPECT_LE(sum, j["wall_time"].get<double>());
+  // a run on raw sensors casts rays and perceives
+  EXPECT_GT(j["profile"]["lidar"].get<double>(), 0.0);
+  EXPECT_GT(j["profile"]["perception"].get<double>(), 0.0);
+  EXPECT_GT(j["profile"]["physics"].get<double>(), 0.0);
 }
 
 TEST(Cli, FailedExpectationsExitWith3AndSayWhich) {

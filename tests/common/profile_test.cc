@@ -1,0 +1,66 @@
+// the profile's accounting on a clock the test moves: exclusive time per
+// stage, nesting, and the time inside no stage
+#include "autonomy/common/profile.h"
+
+#include <gtest/gtest.h>
+
+namespace paddock {
+namespace {
+
+Profile::Clock::time_point fake_now;
+Profile::Clock::time_point read_fake() { return fake_now; }
+void at(double seconds) {
+  fake_now = Profile::Clock::time_point(std::chrono::duration_cast<Profile::Clock::duration>(std::chrono::duration<double>(seconds)));
+}
+
+TEST(Profile, StagesAreChargedTheirOwnTimeAndAddUpToTheWhole) {
+  at(100.0);
+  Profile p(&read_fake);
+  p.enter(Stage::Physics);  // before start: counted, not timed
+  at(101.0);
+  p.leave();
+  p.start();
+  at(102.0);  // 1 s in no stage
+  p.enter(Stage::Perception);
+  at(104.0);  // 2 s perception
+  {
+    const StageScope inner(&p, Stage::Localisation);
+    at(107.0);  // 3 s localisation, inside perception: not perception's
+    const StageScope deeper(&p, Stage::Localisation);
+    at(107.5);
+  }
+  at(108.0);  // 0.5 s more perception (the scopes closed at 107.5)
+  p.leave();
+  p.leave();  // one leave too many: ignored
+  at(108.25);
+  p.stop();
+  at(200.0);  // after stop: nothing
+  EXPECT_DOUBLE_EQ(p.seconds(Stage::Other), 1.25);
+  EXPECT_DOUBLE_EQ(p.seconds(Stage::Perception), 2.5);
+  EXPECT_DOUBLE_EQ(p.seconds(Stage::Localisation), 3.5);
+  EXPECT_DOUBLE_EQ(p.seconds(Stage::Physics), 0.0);
+  EXPECT_EQ(p.entries(Stage::Physics), 1u);
+  EXPECT_EQ(p.entries(Stage::Localisation), 2u);
+  EXPECT_DOUBLE_EQ(p.total(), 108.25 - 101.0);
+  const StageScope nothing(nullptr, Stage::Control);  // no profile: nothing timed, no crash
+}
+
+TEST(Profile, ScopesDeeperThanItsStackAreChargedToTheDeepestItHolds) {
+  at(0.0);
+  Profile p(&read_fake);
+  p.start();
+  p.enter(Stage::Physics);
+  for (int i = 0; i < 20; ++i) p.enter(i < 15 ? Stage::Physics : Stage::Control);  // 21 open, 16 held
+  at(1.0);
+  for (int i = 0; i < 20; ++i) p.leave();
+  at(3.0);
+  p.leave();
+  p.stop();
+  EXPECT_DOUBLE_EQ(p.seconds(Stage::Physics), 3.0);
+  EXPECT_DOUBLE_EQ(p.seconds(Stage::Control), 0.0);
+  EXPECT_EQ(p.entries(Stage::Control), 5u);
+  EXPECT_EQ(stage_name(Stage::Localisation), "localisation");
+}
+
+}  // namespace
+}  // namespace paddock
