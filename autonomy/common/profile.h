@@ -73,4 +73,11 @@ class StageScope {
   Profile* profile_;
 };
 
+// f() timed as stage s, its result returned as f returns it
+template <class F>
+decltype(auto) timed(Profile* profile, Stage s, F&& f) {
+  const StageScope scope(profile, s);
+  return f();
+}
+
 }  // namespace paddock

@@ -76,11 +76,11 @@ void Stack::on_message(hal::SensorMessage&& m) {
   if (const auto* imu = std::get_if<hal::Imu>(&m)) {
     health_.imu(now_);
     if (localisation_) {
-      const StageScope timed(profile_, Stage::Localisation);
+      const StageScope scope(profile_, Stage::Localisation);
       if (const std::optional<hal::StateEstimate> e = localisation_->on_imu(*imu)) take_estimate(*e);
     }
     if (perception_) {
-      const StageScope timed(profile_, Stage::Perception);
+      const StageScope scope(profile_, Stage::Perception);
       perception_->add(*imu);
     }
     return;
@@ -88,18 +88,18 @@ void Stack::on_message(hal::SensorMessage&& m) {
   if (const auto* wheels = std::get_if<hal::WheelSpeeds>(&m)) {
     health_.wheels(now_);
     if (localisation_) {
-      const StageScope timed(profile_, Stage::Localisation);
+      const StageScope scope(profile_, Stage::Localisation);
       localisation_->on_wheel_speeds(*wheels);
     }
     if (perception_) {
-      const StageScope timed(profile_, Stage::Perception);
+      const StageScope scope(profile_, Stage::Perception);
       perception_->add(*wheels);
     }
     return;
   }
   if (const auto* steering = std::get_if<hal::SteeringAngle>(&m)) {
     if (localisation_) {
-      const StageScope timed(profile_, Stage::Localisation);
+      const StageScope scope(profile_, Stage::Localisation);
       localisation_->on_steering(*steering);
     }
     return;
@@ -108,7 +108,7 @@ void Stack::on_message(hal::SensorMessage&& m) {
     // slam = ground_truth: handed in; otherwise the stack keeps its own
     if (!localisation_) take_estimate(*est);
   } else if (const auto* det = std::get_if<hal::ConeDetections>(&m)) {
-    const StageScope timed(profile_, Stage::Localisation);
+    const StageScope scope(profile_, Stage::Localisation);
     on_detections(*det);
   } else if (const auto* res = std::get_if<hal::ResSignal>(&m)) {
     go_ = go_ || res->go;
@@ -122,22 +122,19 @@ void Stack::on_message(hal::SensorMessage&& m) {
     // placed at the pose it gave
     health_.lidar_scan(now_, scan->points.size());
     if (localisation_) {
-      const StageScope timed(profile_, Stage::Localisation);
+      const StageScope scope(profile_, Stage::Localisation);
       localisation_->on_scan(*scan);
     }
-    const hal::ConeDetections* cones = nullptr;
-    {
-      const StageScope timed(profile_, Stage::Perception);
-      cones = &perception_->process(*scan);
-    }
-    const StageScope timed(profile_, Stage::Localisation);
-    on_detections(*cones);
+    const hal::ConeDetections& cones =
+        timed(profile_, Stage::Perception, [&]() -> const hal::ConeDetections& { return perception_->process(*scan); });
+    const StageScope mapping(profile_, Stage::Localisation);
+    on_detections(cones);
   } else if (auto* boxes = std::get_if<hal::CameraDetections>(&m)) {
     health_.camera(now_, *boxes, state_ ? std::hypot(state_->vx, state_->vy) : 0.0);
-    const StageScope timed(profile_, Stage::Perception);
+    const StageScope scope(profile_, Stage::Perception);
     perception_->add(std::move(*boxes));
   } else if (const auto* frame = std::get_if<hal::CameraFrame>(&m)) {
-    const StageScope timed(profile_, Stage::Perception);
+    const StageScope scope(profile_, Stage::Perception);
     perception_->add(*frame);
   }
 }
@@ -463,11 +460,7 @@ double Stack::emergency_steering(TimeNs now, double dt) {
   in.yaw_rate = state_->yaw_rate;
   in.trajectory = &trajectory_;
   in.max_speed = 0.0;
-  control::ControlOutput out;
-  {
-    const StageScope timed(profile_, Stage::Control);
-    out = controller_.update(in);
-  }
+  const control::ControlOutput out = timed(profile_, Stage::Control, [&] { return controller_.update(in); });
   return out.status == control::Status::Ok ? out.steering_angle : 0.0;
 }
 
@@ -481,7 +474,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   if (perception_) perception_->set_camera_distrusted(health_.camera_distrusted());
   // frames that came before the state estimate of their instant
   {
-    const StageScope timed(profile_, Stage::Localisation);
+    const StageScope scope(profile_, Stage::Localisation);
     while (!waiting_.empty() && !history_.empty() && waiting_.front().stamp <= history_.back().stamp) {
       add_to_map(waiting_.front());
       waiting_.pop_front();
@@ -497,7 +490,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
 
   // planner = delaunay: plan whenever the map has news (also before the go, so the car is ready)
   if (params_.autonomy.planner == PlannerMode::Delaunay && state_ && map_news_) {
-    const StageScope timed(profile_, Stage::Planning);
+    const StageScope scope(profile_, Stage::Planning);
     plan(*state_);
   }
 
@@ -571,11 +564,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   in.yaw_rate = st.yaw_rate;
   in.trajectory = &trajectory_;
   in.max_speed = max_speed;
-  control::ControlOutput out;
-  {
-    const StageScope timed(profile_, Stage::Control);
-    out = controller_.update(in);
-  }
+  const control::ControlOutput out = timed(profile_, Stage::Control, [&] { return controller_.update(in); });
   telemetry_.control = out.diagnostics;
   telemetry_.control_ok = out.status == control::Status::Ok;
   if (!telemetry_.control_ok) {

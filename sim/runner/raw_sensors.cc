@@ -82,12 +82,12 @@ void RawSensors::update_scene(const world::ConeWorld& cones, const FaultInjector
 const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeWorld& cones, const PoseHistory& poses,
                                                   SimHal& hal, FaultInjector& faults, double t) {
   {
-    const StageScope timed(profile_, Stage::Lidar);
+    const StageScope scope(profile_, Stage::Lidar);
     update_scene(cones, faults, t);
   }
   const TimeNs start = now - lidar_.period_ns();
   if (camera_ && !faults.camera_dead(t)) {
-    const StageScope timed(profile_, Stage::Camera);
+    const StageScope scope(profile_, Stage::Camera);
     const TimeNs exposure = sensors::trigger_time(lidar_.params(), camera_->params().trigger_azimuth, start);
     if (frozen_ && faults.camera_frozen(t)) {
       // the same image again, stamped anew: the node finds the same boxes on it
@@ -109,7 +109,7 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
     truth_.clear();
     return truth_;
   }
-  const StageScope timed(profile_, Stage::Lidar);
+  const StageScope scope(profile_, Stage::Lidar);
   std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [&poses](TimeNs at) { return poses.at(at); }, start);
   faults.filter_lidar(t, raw);
   truth_.resize(raw.size());

@@ -231,15 +231,15 @@ std::unique_ptr<WireLink> make_wire(const Scenario& sc) {
 struct TimedTap final : WireTap {
   explicit TimedTap(WireTap* inner_tap) : inner(inner_tap) {}
   void lidar_packet(TimeNs at, const std::uint8_t* data, std::size_t size) override {
-    const StageScope timed(profile, Stage::Logging);
+    const StageScope scope(profile, Stage::Logging);
     inner->lidar_packet(at, data, size);
   }
   void can_frame(TimeNs at, bool to_stack, const std::uint8_t* frame) override {
-    const StageScope timed(profile, Stage::Logging);
+    const StageScope scope(profile, Stage::Logging);
     inner->can_frame(at, to_stack, frame);
   }
   void message(TimeNs at, const hal::SensorMessage& m) override {
-    const StageScope timed(profile, Stage::Logging);
+    const StageScope scope(profile, Stage::Logging);
     inner->message(at, m);
   }
   WireTap* inner;
@@ -346,11 +346,11 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
   state.profile.start();
   for (;;) {
     for (Observer* o : observers) {
-      const StageScope timed(&state.profile, o == &log ? Stage::Logging : Stage::Scoring);
+      const StageScope scope(&state.profile, o == &log ? Stage::Logging : Stage::Scoring);
       o->observe(model, state);
     }
     for (Observer* o : extra) {
-      const StageScope timed(&state.profile, Stage::Logging);  // the caller's: a run's MCAP log
+      const StageScope scope(&state.profile, Stage::Logging);  // the caller's: a run's MCAP log
       o->observe(model, state);
     }
     if (state.done) break;
