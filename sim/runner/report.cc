@@ -293,6 +293,9 @@ std::string profile_text(const RunResult& r) {
   }
   o << "| total | " << fixed(total, 3) << " | 100.0 % | " << fixed(r.sim_time > 0 ? 1000.0 * total / r.sim_time : 0.0, 2)
     << " |\n";
+  o << "page faults " << r.page_faults << " in the loop ("
+    << fixed(r.sim_time > 0 ? static_cast<double>(r.page_faults) / r.sim_time : 0.0, 0)
+    << " per simulated s), peak memory " << fixed(r.peak_rss_mb, 0) << " MiB\n";
   return o.str();
 }
 
@@ -385,6 +388,8 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"wall_time", r.wall_time},
       {"realtime_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0},
       {"profile", profile},
+      {"page_faults", r.page_faults},
+      {"peak_rss_mb", r.peak_rss_mb},
       {"tracking", r.stack_remote ? Json(nullptr) : tracking(r.tracking.rms, r.tracking.max, r.tracking.itae)},
       {"energy", r.energy},
       {"slam", r.stack_remote ? Json(nullptr) : Json(slam_json(s, r.slam))},

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include <sys/resource.h>
+
 namespace paddock::runner {
 namespace {
 
@@ -246,6 +248,22 @@ struct TimedTap final : WireTap {
   Profile* profile = nullptr;
 };
 
+// this thread's page faults so far (minor: a page first touched; major: read
+// from the disk) and the process's peak resident set (KiB)
+struct Faults {
+  long minor = 0, major = 0, peak_rss_kib = 0;
+};
+Faults faults_now() {
+  rusage u{};
+  Faults f;
+  if (getrusage(RUSAGE_THREAD, &u) == 0) {
+    f.minor = u.ru_minflt;
+    f.major = u.ru_majflt;
+  }
+  if (getrusage(RUSAGE_SELF, &u) == 0) f.peak_rss_kib = u.ru_maxrss;
+  return f;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -343,6 +361,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
   SlamScorer slam;
   SnapshotRecorder snapshot;
   Observer* const observers[] = {&snapshot, &scorer, &slam, &log};
+  const Faults faults0 = faults_now();
   state.profile.start();
   for (;;) {
     for (Observer* o : observers) {
@@ -357,6 +376,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
     step(model, state);
   }
   state.profile.stop();
+  const Faults faults1 = faults_now();
 
   RunResult result = results_of(state);
   result.stack_remote = state.hal.remote();
@@ -373,6 +393,8 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
   if (limit.valid()) result.limit = limit.get();
   if (result.limit) result.limit_lap = result.limit->min_curvature.lap_time;
   result.profile = state.profile;
+  result.page_faults = (faults1.minor - faults0.minor) + (faults1.major - faults0.major);
+  result.peak_rss_mb = static_cast<double>(faults1.peak_rss_kib) / 1024.0;
   result.wall_time = seconds_since(wall0);
   return result;
 }

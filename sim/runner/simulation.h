@@ -180,6 +180,10 @@ struct RunResult {
   std::optional<double> limit_lap;
   // the run's wall time by stage (a measurement of the machine, as wall_time)
   Profile profile;
+  // the closed loop's page faults (its thread's: pages first touched, or
+  // read from the disk), and the process's peak resident memory (MiB)
+  long page_faults = 0;
+  double peak_rss_mb = 0.0;
 };
 
 // runs one scenario to its end (finish or DNF); deterministic for a given

@@ -103,6 +103,8 @@ std::string without_wall_clock(std::string json) {
   json = std::regex_replace(json, std::regex("\"update_ms_mean\":[^,]*,"), "");
   json = std::regex_replace(json, std::regex("\"update_ms_p99\":[^,]*,"), "");
   json = std::regex_replace(json, std::regex("\"profile\":\\{[^}]*\\},"), "");
+  json = std::regex_replace(json, std::regex("\"page_faults\":[^,]*,"), "");
+  json = std::regex_replace(json, std::regex("\"peak_rss_mb\":[^,]*,"), "");
   return std::regex_replace(json, std::regex("\"realtime_factor\":[^,]*,"), "");
 }
 
@@ -214,6 +216,10 @@ TEST(Cli, ProfileSaysWhereTheWallTimeWent) {
   EXPECT_GT(j["profile"]["lidar"].get<double>(), 0.0);
   EXPECT_GT(j["profile"]["perception"].get<double>(), 0.0);
   EXPECT_GT(j["profile"]["physics"].get<double>(), 0.0);
+  // the process holds at least the track and the stack; the loop touches new pages
+  EXPECT_GT(j["peak_rss_mb"].get<double>(), 10.0);
+  EXPECT_GE(j["page_faults"].get<long>(), 0);
+  EXPECT_THAT(o.output, HasSubstr(" MiB\n"));
 }
 
 TEST(Cli, FailedExpectationsExitWith3AndSayWhich) {
