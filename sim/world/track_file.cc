@@ -126,10 +126,6 @@ void find_doubles(TrackFile& f) {
   }
 }
 
-}  // namespace
-
-namespace {
-
 // every cone, the start and the timekeeping posts within kMaxTrackSpan of the
 // first cone: else the first line (in the file) of one that is not
 void check_span(const TrackFile& f) {
