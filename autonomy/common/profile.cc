@@ -23,6 +23,7 @@ std::string_view stage_name(Stage s) {
 void Profile::start() {
   if (running_) return;
   running_ = true;
+  if (count_ != nullptr) count_mark_ = count_();
   mark_ = now_();
 }
 
@@ -38,6 +39,11 @@ void Profile::charge() {
   const Stage s = depth_ == 0 ? Stage::Other : open_[static_cast<std::size_t>(std::min(depth_, kDepth) - 1)];
   seconds_[static_cast<std::size_t>(s)] += std::chrono::duration<double>(t - mark_).count();
   mark_ = t;
+  if (count_ != nullptr) {
+    const std::uint64_t n = count_();
+    allocations_[static_cast<std::size_t>(s)] += n - count_mark_;
+    count_mark_ = n;
+  }
 }
 
 void Profile::enter(Stage s) {
@@ -57,6 +63,12 @@ double Profile::total() const {
   double t = 0.0;
   for (double s : seconds_) t += s;
   return t;
+}
+
+std::uint64_t Profile::total_allocations() const {
+  std::uint64_t n = 0;
+  for (std::uint64_t a : allocations_) n += a;
+  return n;
 }
 
 }  // namespace paddock

@@ -3,7 +3,9 @@
 // stage, measured where its work is done. A stage entered inside another is
 // charged its own time alone (exclusive time), so the stages and `other` (the
 // time inside no stage) add up to the time between start() and stop().
-// Nothing is timed through a null Profile pointer (StageScope).
+// Nothing is timed through a null Profile pointer (StageScope). Given a
+// counter of the thread's allocations, each stage is charged the allocations
+// made inside it too, the same way.
 #include <array>
 #include <chrono>
 #include <cstddef>
@@ -33,7 +35,8 @@ class Profile {
  public:
   using Clock = std::chrono::steady_clock;
   using Now = Clock::time_point (*)();
-  explicit Profile(Now now = &Clock::now) : now_(now) {}
+  using Count = std::uint64_t (*)();
+  explicit Profile(Now now = &Clock::now, Count count = nullptr) : now_(now), count_(count) {}
 
   void start();
   void stop();
@@ -43,15 +46,22 @@ class Profile {
   double seconds(Stage s) const { return seconds_[static_cast<std::size_t>(s)]; }
   std::uint64_t entries(Stage s) const { return entries_[static_cast<std::size_t>(s)]; }
   double total() const;  // s, every stage and other
+  // allocations made in the stage (0 without a counter)
+  bool counts_allocations() const { return count_ != nullptr; }
+  std::uint64_t allocations(Stage s) const { return allocations_[static_cast<std::size_t>(s)]; }
+  std::uint64_t total_allocations() const;
 
  private:
   void charge();  // the time since the last mark, to the innermost stage
   static constexpr int kDepth = 16;  // deeper scopes are charged to the 16th
 
   Now now_;
+  Count count_;
   bool running_ = false;
   Clock::time_point mark_{};
+  std::uint64_t count_mark_ = 0;
   std::array<double, kStageCount> seconds_{};
+  std::array<std::uint64_t, kStageCount> allocations_{};
   std::array<std::uint64_t, kStageCount> entries_{};
   std::array<Stage, kDepth> open_{};  // open_[0]: Other
   int depth_ = 0;                     // open stages (may exceed kDepth)

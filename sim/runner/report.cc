@@ -1,12 +1,13 @@
 #include "sim/runner/report.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <limits>
 #include <cstdio>
-#include <nlohmann/json.hpp>
-#include <algorithm>
+#include <limits>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 #include "autonomy/common/format.h"
 #include "sim/world/track.h"
@@ -278,24 +279,32 @@ nlohmann::json slam_json(const Scenario& s, const SlamMetrics& m) {
 
 std::string profile_text(const RunResult& r) {
   // the stages by their share, largest first; per simulated second the
-  // wall milliseconds each costs (its share of the real-time factor)
+  // wall milliseconds each costs (its share of the real-time factor) and,
+  // where counted, the allocations it makes
   std::vector<Stage> order;
   for (std::size_t i = 0; i < kStageCount; ++i) order.push_back(static_cast<Stage>(i));
   std::stable_sort(order.begin(), order.end(),
                    [&r](Stage a, Stage b) { return r.profile.seconds(a) > r.profile.seconds(b); });
   const double total = r.profile.total();
+  const bool counted = r.profile.counts_allocations();
+  const auto per_s = [&r](double x) { return r.sim_time > 0 ? x / r.sim_time : 0.0; };
   std::ostringstream o;
-  o << "| stage | wall s | share | ms per simulated s |\n|---|---:|---:|---:|\n";
+  o << "| stage | wall s | share | ms per simulated s |" << (counted ? " allocations per simulated s |" : "")
+    << "\n|---|---:|---:|---:|" << (counted ? "---:|" : "") << "\n";
   for (Stage st : order) {
     const double sec = r.profile.seconds(st);
     o << "| " << stage_name(st) << " | " << fixed(sec, 3) << " | " << fixed(total > 0 ? 100.0 * sec / total : 0.0, 1)
-      << " % | " << fixed(r.sim_time > 0 ? 1000.0 * sec / r.sim_time : 0.0, 2) << " |\n";
+      << " % | " << fixed(1000.0 * per_s(sec), 2) << " |";
+    if (counted) o << " " << fixed(per_s(static_cast<double>(r.profile.allocations(st))), 0) << " |";
+    o << "\n";
   }
-  o << "| total | " << fixed(total, 3) << " | 100.0 % | " << fixed(r.sim_time > 0 ? 1000.0 * total / r.sim_time : 0.0, 2)
-    << " |\n";
-  o << "page faults " << r.page_faults << " in the loop ("
-    << fixed(r.sim_time > 0 ? static_cast<double>(r.page_faults) / r.sim_time : 0.0, 0)
-    << " per simulated s), peak memory " << fixed(r.peak_rss_mb, 0) << " MiB\n";
+  o << "| total | " << fixed(total, 3) << " | 100.0 % | " << fixed(1000.0 * per_s(total), 2) << " |";
+  if (counted) o << " " << fixed(per_s(static_cast<double>(r.profile.total_allocations())), 0) << " |";
+  o << "\n";
+  o << "page faults " << r.page_faults << " in the loop (" << fixed(per_s(static_cast<double>(r.page_faults)), 0)
+    << " per simulated s)";
+  if (counted) o << ", allocations " << r.profile.total_allocations();
+  o << ", peak memory " << fixed(r.peak_rss_mb, 0) << " MiB\n";
   return o.str();
 }
 
@@ -371,6 +380,16 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
     const auto stage = static_cast<Stage>(i);
     profile[std::string(stage_name(stage))] = r.profile.seconds(stage);
   }
+  // the loop's allocations, in all and per stage (null where not counted:
+  // a sanitizer's build)
+  Json allocations = nullptr;
+  if (r.profile.counts_allocations()) {
+    allocations = {{"total", r.profile.total_allocations()}};
+    for (std::size_t i = 0; i < kStageCount; ++i) {
+      const auto stage = static_cast<Stage>(i);
+      allocations[std::string(stage_name(stage))] = r.profile.allocations(stage);
+    }
+  }
   // JSON has no NaN or infinity: nlohmann writes them as null
   const Json j = {
       {"scenario", s.name},
@@ -389,6 +408,7 @@ std::string summary_json(const Scenario& s, const RunResult& r, const std::vecto
       {"realtime_factor", r.wall_time > 0 ? r.sim_time / r.wall_time : 0.0},
       {"profile", profile},
       {"page_faults", r.page_faults},
+      {"allocations", allocations},
       {"peak_rss_mb", r.peak_rss_mb},
       {"tracking", r.stack_remote ? Json(nullptr) : tracking(r.tracking.rms, r.tracking.max, r.tracking.itae)},
       {"energy", r.energy},

@@ -8,6 +8,8 @@
 
 #include <sys/resource.h>
 
+#include "sim/runner/allocations.h"
+
 namespace paddock::runner {
 namespace {
 
@@ -250,12 +252,12 @@ struct TimedTap final : WireTap {
 
 // this thread's page faults so far (minor: a page first touched; major: read
 // from the disk) and the process's peak resident set (KiB)
-struct Faults {
+struct PageFaults {
   long minor = 0, major = 0, peak_rss_kib = 0;
 };
-Faults faults_now() {
+PageFaults page_faults_now() {
   rusage u{};
-  Faults f;
+  PageFaults f;
   if (getrusage(RUSAGE_THREAD, &u) == 0) {
     f.minor = u.ru_minflt;
     f.major = u.ru_majflt;
@@ -286,7 +288,8 @@ SimState::SimState(const SimModel& model, WireTap* tap)
       imu(model.scenario.imu, stream_seed(model.scenario.scenario.seed, "imu")),
       wheel_speeds(model.scenario.wheel_speeds, stream_seed(model.scenario.scenario.seed, "wheel_speeds")),
       steering(model.scenario.steering_sensor, stream_seed(model.scenario.scenario.seed, "steering_sensor")),
-      true_poses(model.pose_history_span) {
+      true_poses(model.pose_history_span),
+      profile(&Profile::Clock::now, allocations_counted() ? &thread_allocations : nullptr) {
   hal.set_tap(tap);
   stack.set_profile(&profile);
   if (raw) raw->set_profile(&profile);
@@ -361,7 +364,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
   SlamScorer slam;
   SnapshotRecorder snapshot;
   Observer* const observers[] = {&snapshot, &scorer, &slam, &log};
-  const Faults faults0 = faults_now();
+  const PageFaults faults0 = page_faults_now();
   state.profile.start();
   for (;;) {
     for (Observer* o : observers) {
@@ -376,7 +379,7 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
     step(model, state);
   }
   state.profile.stop();
-  const Faults faults1 = faults_now();
+  const PageFaults faults1 = page_faults_now();
 
   RunResult result = results_of(state);
   result.stack_remote = state.hal.remote();

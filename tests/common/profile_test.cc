@@ -62,5 +62,39 @@ TEST(Profile, ScopesDeeperThanItsStackAreChargedToTheDeepestItHolds) {
   EXPECT_EQ(stage_name(Stage::Localisation), "localisation");
 }
 
+std::uint64_t fake_allocations = 0;
+std::uint64_t read_allocations() { return fake_allocations; }
+
+TEST(Profile, StagesAreChargedTheAllocationsMadeInsideThem) {
+  at(0.0);
+  fake_allocations = 1000;
+  Profile untimed(&read_fake);
+  EXPECT_FALSE(untimed.counts_allocations());
+  Profile p(&read_fake, &read_allocations);
+  EXPECT_TRUE(p.counts_allocations());
+  p.enter(Stage::Camera);
+  fake_allocations += 50;  // before start: not counted
+  p.leave();
+  p.start();
+  fake_allocations += 3;  // other
+  {
+    const StageScope camera(&p, Stage::Camera);
+    fake_allocations += 7;
+    {
+      const StageScope slam(&p, Stage::Localisation);
+      fake_allocations += 11;  // localisation's, not the camera's
+    }
+    fake_allocations += 2;
+  }
+  p.stop();
+  fake_allocations += 100;  // after stop: nothing
+  EXPECT_EQ(p.allocations(Stage::Other), 3u);
+  EXPECT_EQ(p.allocations(Stage::Camera), 9u);
+  EXPECT_EQ(p.allocations(Stage::Localisation), 11u);
+  EXPECT_EQ(p.allocations(Stage::Physics), 0u);
+  EXPECT_EQ(p.total_allocations(), 23u);
+  EXPECT_EQ(untimed.total_allocations(), 0u);
+}
+
 }  // namespace
 }  // namespace paddock
