@@ -3,32 +3,37 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <string_view>
 #include <utility>
 
 #include "sim/runner/files.h"
 
 namespace paddock::runner {
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string::npos) return "";
-  const auto e = s.find_last_not_of(" \t\r");
-  return s.substr(b, e - b + 1);
-}
 
 namespace {
 
 namespace fs = std::filesystem;
 
+// the blanks trim() drops
+bool blank(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+std::string_view trim_view(std::string_view s) {
+  std::size_t b = 0, e = s.size();
+  while (b < e && blank(s[b])) ++b;
+  while (e > b && blank(s[e - 1])) --e;
+  return s.substr(b, e - b);
+}
+
 // a ';' or '#' that starts the line or follows whitespace begins a comment
-std::string strip_comment(const std::string& s) {
+std::string_view strip_comment(std::string_view s) {
   for (std::size_t i = 0; i < s.size(); ++i) {
     if ((s[i] == ';' || s[i] == '#') && (i == 0 || s[i - 1] == ' ' || s[i - 1] == '\t')) return s.substr(0, i);
   }
   return s;
 }
 
-bool valid_name(const std::string& s) {
+bool valid_name(std::string_view s) {
   if (s.empty()) return false;
   return std::all_of(s.begin(), s.end(), [](char c) {
     return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.';
@@ -44,37 +49,40 @@ class Reader {
     std::map<std::pair<std::string, std::string>, int> seen;  // (section, key) -> line, this file only
     int line_no = 0;
     std::size_t pos = 0;
-    while (pos <= text.size()) {
-      const auto nl = text.find('\n', pos);
-      const std::string raw = text.substr(pos, nl == std::string::npos ? std::string::npos : nl - pos);
-      pos = nl == std::string::npos ? text.size() + 1 : nl + 1;
+    // the lines as views of the text: a string is made for what is kept
+    // (and for a message), not for every line read
+    const std::string_view all(text);
+    while (pos <= all.size()) {
+      const auto nl = all.find('\n', pos);
+      const std::string_view raw = all.substr(pos, nl == std::string_view::npos ? std::string_view::npos : nl - pos);
+      pos = nl == std::string_view::npos ? all.size() + 1 : nl + 1;
       ++line_no;
-      const std::string where = source + ":" + std::to_string(line_no);
-      const std::string line = trim(strip_comment(raw));
+      const auto where = [&source, line_no] { return source + ":" + std::to_string(line_no); };
+      const std::string_view line = trim_view(strip_comment(raw));
       if (line.empty()) continue;
       // a section header
       if (line.front() == '[') {
-        if (line.back() != ']') throw UserError(where + ": malformed section header '" + line + "', expected [name]");
-        section = trim(line.substr(1, line.size() - 2));
-        if (!valid_name(section)) throw UserError(where + ": bad section name '" + section + "', expected letters, digits and _");
+        if (line.back() != ']') throw UserError(where() + ": malformed section header '" + std::string(line) + "', expected [name]");
+        section = std::string(trim_view(line.substr(1, line.size() - 2)));
+        if (!valid_name(section)) throw UserError(where() + ": bad section name '" + section + "', expected letters, digits and _");
         continue;
       }
       // key = value
       const auto eq = line.find('=');
-      if (eq == std::string::npos) throw UserError(where + ": expected 'key = value', '[section]' or a comment, got '" + line + "'");
-      const std::string key = trim(line.substr(0, eq));
-      const std::string value = trim(line.substr(eq + 1));
-      if (!valid_name(key)) throw UserError(where + ": bad key '" + key + "', expected letters, digits and _");
+      if (eq == std::string_view::npos) throw UserError(where() + ": expected 'key = value', '[section]' or a comment, got '" + std::string(line) + "'");
+      const std::string key(trim_view(line.substr(0, eq)));
+      const std::string value(trim_view(line.substr(eq + 1)));
+      if (!valid_name(key)) throw UserError(where() + ": bad key '" + key + "', expected letters, digits and _");
       if (key == "include") {
-        if (value.empty()) throw UserError(where + ": include needs a path");
-        if (base_dir.empty()) throw UserError(where + ": include is not allowed here (text that is not a file includes nothing)");
-        include((base_dir / value).lexically_normal(), where);
+        if (value.empty()) throw UserError(where() + ": include needs a path");
+        if (base_dir.empty()) throw UserError(where() + ": include is not allowed here (text that is not a file includes nothing)");
+        include((base_dir / value).lexically_normal(), where());
         continue;
       }
-      if (section.empty()) throw UserError(where + ": key '" + key + "' is outside any [section]");
+      if (section.empty()) throw UserError(where() + ": key '" + key + "' is outside any [section]");
       const auto [it, fresh] = seen.emplace(std::make_pair(section, key), line_no);
       if (!fresh) {
-        throw UserError(where + ": [" + section + "] " + key + " is already set at line " + std::to_string(it->second) + " of this file");
+        throw UserError(where() + ": [" + section + "] " + key + " is already set at line " + std::to_string(it->second) + " of this file");
       }
       entries.push_back({section, key, value, source, line_no});
     }
@@ -107,6 +115,8 @@ class Reader {
 };
 
 }  // namespace
+
+std::string trim(const std::string& s) { return std::string(trim_view(s)); }
 
 std::vector<IniEntry> read_ini_file(const std::string& path) {
   const std::string text = read_file(path);
