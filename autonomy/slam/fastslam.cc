@@ -1,6 +1,7 @@
 #include "autonomy/slam/fastslam.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -169,7 +170,12 @@ void FastSlam::BlockPool::give(void* p, std::size_t bytes) {
 FastSlam::Slot& FastSlam::Particle::mutable_slot(int i, const BlockAlloc& a) {
   BlockRef& ref = blocks[static_cast<std::size_t>(i / kLandmarkBlock)];
   std::shared_ptr<Block>& b = live[static_cast<std::size_t>(ref.live)].block;
-  if (b.use_count() > 1) {
+  // with the particles split between threads, another may just have let go
+  // of this block (its clone made): a count of 1 read here is ordered after
+  // that thread's reads of it by the fence (its release is a release)
+  const long holders = b.use_count();
+  std::atomic_thread_fence(std::memory_order_acquire);
+  if (holders > 1) {
     b = std::allocate_shared<Block>(a, *b);  // copy on write
     ref.block = b.get();
   }
@@ -211,7 +217,7 @@ void FastSlam::Particle::sweep() {
 }
 
 FastSlam::FastSlam(const FastSlamParams& p, std::uint64_t seed)
-    : params_(params::require_valid(p, "FastSlamParams")), rng_(seed) {
+    : params_(params::require_valid(p, "FastSlamParams")), rng_(seed), workers_(params_.threads) {
   reset(Pose2{});
 }
 
@@ -257,9 +263,12 @@ void FastSlam::predict(const Pose2& delta) {
   }
 }
 
-Pose2 FastSlam::sample_pose(const Pose2& mean, const Matrix3d& cov) {
+Vector3d FastSlam::standard_normals() {
   std::normal_distribution<double> n01(0.0, 1.0);
-  const Vector3d n(n01(rng_), n01(rng_), n01(rng_));
+  return Vector3d(n01(rng_), n01(rng_), n01(rng_));
+}
+
+Pose2 FastSlam::sample_pose(const Pose2& mean, const Matrix3d& cov, const Vector3d& n) {
   Vector3d d;
   Eigen::LLT<Matrix3d> llt(cov);
   if (llt.info() == Eigen::Success) {
@@ -313,11 +322,23 @@ void FastSlam::update(const std::vector<Observation>& obs, const std::vector<flo
   std::vector<double>& ll = log_lik_;
   ll.assign(n, 0.0);
   frame_ids_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const int parent = particles_[i].copy_of;
-    update_particle(particles_[i], frame_, parent >= 0 && i > 0 && particles_[i - 1].copy_of == parent, ll[i],
-                    frame_ids_[i]);
-  }
+  // the particles' draws in their order, from the one generator, before the
+  // particles are split between the threads (the same stream however many)
+  draws_.resize(n);
+  for (Vector3d& d : draws_) d = standard_normals();
+  const int parts = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(workers_.threads()), n));
+  scratch_.resize(static_cast<std::size_t>(workers_.threads()));
+  workers_.run([&](int part) {
+    if (part >= parts) return;
+    const auto [begin, end] = Workers::range(n, parts, part);
+    Scratch& w = scratch_[static_cast<std::size_t>(part)];
+    for (std::size_t i = begin; i < end; ++i) {
+      // a copy of the previous particle reuses its association: within a part
+      const int parent = particles_[i].copy_of;
+      update_particle(particles_[i], frame_, parent >= 0 && i > begin && particles_[i - 1].copy_of == parent, ll[i],
+                      frame_ids_[i], draws_[i], w);
+    }
+  });
   for (Particle& p : particles_) p.copy_of = -1;  // each drew its own pose
 
   // reweight (in logs, about the largest, against underflow) and normalise
@@ -348,26 +369,26 @@ void FastSlam::update(const std::vector<Observation>& obs, const std::vector<flo
   update_covariance();
 }
 
-void FastSlam::gather_near(const Particle& p) {
+void FastSlam::gather_near(const Particle& p, Scratch& w) {
   // the landmarks near enough to matter this frame (view, or an
   // observation's reach): their indices, and their positions in contiguous
   // arrays for the association's search
   const FastSlamParams& pr = params_;
   const double reach = std::max(pr.view_range, 0.0) + pr.search_radius;
-  near_.clear();
-  near_live_.clear();
-  near_x_.clear();
-  near_y_.clear();
+  w.near.clear();
+  w.near_live.clear();
+  w.near_x.clear();
+  w.near_y.clear();
   const double under2 = 0.25 * pr.min_range * pr.min_range;
   // the blocks in reach (none of the others' landmarks is: most blocks, the
   // car meets them in order); their alive slots' means and covariances asked
   // of memory all at once: a particle's blocks are mostly its own copies,
   // rarely in cache, and one after another they would cost a miss each
-  in_reach_.clear();
+  w.in_reach.clear();
   for (std::size_t l = 0; l < p.live.size(); ++l) {
     const LiveBlock& lb = p.live[l];
     if (lb.bounds.squared_distance(p.pose.position()) >= reach * reach) continue;
-    in_reach_.push_back(static_cast<int>(l));
+    w.in_reach.push_back(static_cast<int>(l));
     const Block& block = *lb.block;
     for (std::uint32_t alive = lb.alive; alive != 0; alive &= alive - 1) {
       const char* slot = reinterpret_cast<const char*>(&block.slots[static_cast<std::size_t>(__builtin_ctz(alive))]);
@@ -375,7 +396,7 @@ void FastSlam::gather_near(const Particle& p) {
       __builtin_prefetch(slot + sizeof(Vec2) + sizeof(Eigen::Matrix2d) - 1);
     }
   }
-  for (int l : in_reach_) {
+  for (int l : w.in_reach) {
     const LiveBlock& lb = p.live[static_cast<std::size_t>(l)];
     // its alive slots, lowest first (the order of the indices)
     const Block& block = *lb.block;
@@ -385,16 +406,16 @@ void FastSlam::gather_near(const Particle& p) {
       const double d2 = squared_norm(s.lm.mean - p.pose.position());
       // (one under the car has no stable bearing: neither scored nor expected)
       if (d2 < reach * reach && d2 > under2) {
-        near_.push_back(lb.number * kLandmarkBlock + j);
-        near_live_.push_back(l);
-        near_x_.push_back(s.lm.mean.x);
-        near_y_.push_back(s.lm.mean.y);
+        w.near.push_back(lb.number * kLandmarkBlock + j);
+        w.near_live.push_back(l);
+        w.near_x.push_back(s.lm.mean.x);
+        w.near_y.push_back(s.lm.mean.y);
       }
     }
   }
 }
 
-void FastSlam::find_candidates(const Particle& p, const Frame& f) {
+void FastSlam::find_candidates(const Particle& p, const Frame& f, Scratch& w) {
   // each near landmark against the observations landing within
   // search_radius of it (at s^ for 2.0, at the sampled pose for 1.0),
   // scored by likelihood within the gate and above the new-landmark one
@@ -403,12 +424,12 @@ void FastSlam::find_candidates(const Particle& p, const Frame& f) {
   const double log_p0 = std::log(pr.new_landmark_likelihood);
   const double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
   const std::size_t m = f.z.size();
-  land_x_.resize(m);
-  land_y_.resize(m);
+  w.land_x.resize(m);
+  w.land_y.resize(m);
   for (std::size_t k = 0; k < m; ++k) {
     const Vec2 o = f.obs[k]->position;
-    land_x_[k] = p.pose.x + cy * o.x - sy * o.y;
-    land_y_[k] = p.pose.y + sy * o.x + cy * o.y;
+    w.land_x[k] = p.pose.x + cy * o.x - sy * o.y;
+    w.land_y[k] = p.pose.y + sy * o.x + cy * o.y;
   }
   // the observations to try, by their position in the base frame: x, then
   // y within the radius of the landmark's there, and a margin far above the
@@ -416,9 +437,9 @@ void FastSlam::find_candidates(const Particle& p, const Frame& f) {
   const double band = pr.search_radius + 1e-9 * (1.0 + pr.search_radius + std::abs(p.pose.x) + std::abs(p.pose.y));
   const double r2 = pr.search_radius * pr.search_radius;
   const Matrix2d assoc = pr.association_std * pr.association_std * Matrix2d::Identity();
-  cands_.clear();
-  for (std::size_t j = 0; j < near_.size(); ++j) {
-    const double dx = near_x_[j] - p.pose.x, dy = near_y_[j] - p.pose.y;
+  w.cands.clear();
+  for (std::size_t j = 0; j < w.near.size(); ++j) {
+    const double dx = w.near_x[j] - p.pose.x, dy = w.near_y[j] - p.pose.y;
     const double bx = cy * dx + sy * dy, by = cy * dy - sy * dx;
     std::size_t i = static_cast<std::size_t>(std::lower_bound(f.sorted_x.begin(), f.sorted_x.end(), bx - band) - f.sorted_x.begin());
     // h, H_m C H_m^T and H_s P H_s^T: the landmark's, whichever observation
@@ -428,10 +449,10 @@ void FastSlam::find_candidates(const Particle& p, const Frame& f) {
     for (; i < f.sorted_x.size() && f.sorted_x[i] <= bx + band; ++i) {
       if (std::abs(f.sorted_y[i] - by) > band) continue;
       const std::size_t k = static_cast<std::size_t>(f.by_x[i]);
-      const double ex = near_x_[j] - land_x_[k], ey = near_y_[j] - land_y_[k];
+      const double ex = w.near_x[j] - w.land_x[k], ey = w.near_y[j] - w.land_y[k];
       if (ex * ex + ey * ey > r2) continue;
       if (!predicted) {
-        const Slot& s = p.slot(near_[j]);
+        const Slot& s = p.slot(w.near[j]);
         h = predict_measurement(p.pose, s.lm.mean);
         HCH = h.Hm * (s.lm.cov + assoc) * h.Hm.transpose();
         if (v2) HPH = h.Hs * p.P * h.Hs.transpose();
@@ -449,61 +470,61 @@ void FastSlam::find_candidates(const Particle& p, const Frame& f) {
         c.scored = true;
         if (!(c.ll >= log_p0)) continue;
       }
-      cands_.push_back(c);
+      w.cands.push_back(c);
     }
   }
 }
 
-const std::vector<int>& FastSlam::associate(const Particle& p, const Frame& f) {
+const std::vector<int>& FastSlam::associate(const Particle& p, const Frame& f, Scratch& w) {
   // maximum likelihood per observation, one observation per landmark
   // (mutual exclusion): the candidates best first (ties: the earlier
-  // observation, then landmark; near_ is in index order). A candidate alone
+  // observation, then landmark; w.near is in index order). A candidate alone
   // on its observation and on its landmark (most) is taken whatever its
   // likelihood; only its rivals need ranking, their own among them.
-  find_candidates(p, f);
+  find_candidates(p, f, w);
   const std::size_t m = f.z.size();
-  cands_per_obs_.assign(m, 0);
-  cands_per_near_.assign(near_.size(), 0);
-  for (const Candidate& c : cands_) {
-    ++cands_per_obs_[static_cast<std::size_t>(c.obs)];
-    ++cands_per_near_[static_cast<std::size_t>(c.near)];
+  w.cands_per_obs.assign(m, 0);
+  w.cands_per_near.assign(w.near.size(), 0);
+  for (const Candidate& c : w.cands) {
+    ++w.cands_per_obs[static_cast<std::size_t>(c.obs)];
+    ++w.cands_per_near[static_cast<std::size_t>(c.near)];
   }
-  match_.assign(m, -1);
-  near_taken_.assign(near_.size(), 0);
-  rivals_.clear();
-  for (Candidate& c : cands_) {
-    if (cands_per_obs_[static_cast<std::size_t>(c.obs)] == 1 && cands_per_near_[static_cast<std::size_t>(c.near)] == 1) {
-      match_[static_cast<std::size_t>(c.obs)] = c.near;
-      near_taken_[static_cast<std::size_t>(c.near)] = 1;
+  w.match.assign(m, -1);
+  w.near_taken.assign(w.near.size(), 0);
+  w.rivals.clear();
+  for (Candidate& c : w.cands) {
+    if (w.cands_per_obs[static_cast<std::size_t>(c.obs)] == 1 && w.cands_per_near[static_cast<std::size_t>(c.near)] == 1) {
+      w.match[static_cast<std::size_t>(c.obs)] = c.near;
+      w.near_taken[static_cast<std::size_t>(c.near)] = 1;
       continue;
     }
     if (!c.scored) c.ll = log_gauss(GaussTerms{c.d2, c.det});
-    rivals_.push_back(c);
+    w.rivals.push_back(c);
   }
-  std::sort(rivals_.begin(), rivals_.end(), [](const Candidate& a, const Candidate& b) {
+  std::sort(w.rivals.begin(), w.rivals.end(), [](const Candidate& a, const Candidate& b) {
     if (a.ll != b.ll) return a.ll > b.ll;
     if (a.obs != b.obs) return a.obs < b.obs;
     return a.near < b.near;
   });
-  for (const Candidate& c : rivals_) {
-    int& match = match_[static_cast<std::size_t>(c.obs)];
-    char& taken = near_taken_[static_cast<std::size_t>(c.near)];
+  for (const Candidate& c : w.rivals) {
+    int& match = w.match[static_cast<std::size_t>(c.obs)];
+    char& taken = w.near_taken[static_cast<std::size_t>(c.near)];
     if (match >= 0 || taken) continue;
     match = c.near;
     taken = 1;
   }
-  return match_;
+  return w.match;
 }
 
-void FastSlam::propose(const Particle& p, const Frame& f, const std::vector<int>& match) {
+void FastSlam::propose(const Particle& p, const Frame& f, const std::vector<int>& match, Scratch& w) {
   // FastSLAM 2.0: fold the associated observations into the pose's proposal,
-  // weigh by each one's likelihood given the ones before (into proposal_)
+  // weigh by each one's likelihood given the ones before (into w.proposal)
   Vector3d mu(p.pose.x, p.pose.y, p.pose.yaw);
   Matrix3d Sigma = p.P;
   double log_lik = 0.0;
   for (std::size_t k = 0; k < f.z.size(); ++k) {
     if (match[k] < 0) continue;
-    const Slot& s = p.slot(near_[static_cast<std::size_t>(match[k])]);
+    const Slot& s = p.slot(w.near[static_cast<std::size_t>(match[k])]);
     const Pose2 at{mu(0), mu(1), mu(2)};
     const Predicted h = predict_measurement(at, s.lm.mean);
     const Matrix2d Z = h.Hs * Sigma * h.Hs.transpose() + h.Hm * s.lm.cov * h.Hm.transpose() + f.R[k];
@@ -515,17 +536,18 @@ void FastSlam::propose(const Particle& p, const Frame& f, const std::vector<int>
     Sigma -= Ks * Z * Ks.transpose();
     Sigma = 0.5 * (Sigma + Sigma.transpose());
   }
-  proposal_ = {{mu(0), mu(1), mu(2)}, Sigma, log_lik};
+  w.proposal = {{mu(0), mu(1), mu(2)}, Sigma, log_lik};
 }
 
-void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik) {
+void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik,
+                                Scratch& w) {
   // the associated landmarks' EKFs at the sampled pose (1.0 weighs here)
   const FastSlamParams& pr = params_;
   for (std::size_t k = 0; k < f.z.size(); ++k) {
     if (match[k] < 0) continue;
     const Observation& o = *f.obs[k];
     const std::size_t j = static_cast<std::size_t>(match[k]);
-    Slot& s = p.mutable_slot(near_[j], block_alloc_);
+    Slot& s = p.mutable_slot(w.near[j], block_alloc_);
     Landmark& lm = s.lm;
     const Predicted h = predict_measurement(p.pose, lm.mean);
     const Matrix2d S = h.Hm * lm.cov * h.Hm.transpose() + f.R[k];
@@ -534,7 +556,7 @@ void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<i
     const Matrix2d K = lm.cov * h.Hm.transpose() * S.inverse();
     const Vector2d dm = K * nu;
     lm.mean += Vec2{dm(0), dm(1)};
-    p.live[static_cast<std::size_t>(near_live_[j])].bounds.cover(lm.mean);
+    p.live[static_cast<std::size_t>(w.near_live[j])].bounds.cover(lm.mean);
     lm.cov = (Matrix2d::Identity() - K * h.Hm) * lm.cov;
     lm.cov = 0.5 * (lm.cov + lm.cov.transpose());
     ++lm.sightings;
@@ -544,19 +566,19 @@ void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<i
   }
 }
 
-void FastSlam::expect_and_remove(Particle& p) {
+void FastSlam::expect_and_remove(Particle& p, Scratch& w) {
   // expectations and removal of the landmarks that were there before this frame
   // (in view: |b| < view_range and |bearing| < view_half_fov <=> b_x > |b| cos(view_half_fov))
   const FastSlamParams& pr = params_;
   const double cy = std::cos(p.pose.yaw), sy = std::sin(p.pose.yaw);
   const double cos_fov = std::cos(pr.view_half_fov);
   bool died = false;
-  for (std::size_t j = 0; j < near_.size(); ++j) {
-    const int i = near_[j];
-    const bool seen = near_taken_[j] != 0;
+  for (std::size_t j = 0; j < w.near.size(); ++j) {
+    const int i = w.near[j];
+    const bool seen = w.near_taken[j] != 0;
     if (!seen) {
-      // (its mean is still near_'s copy: only the seen ones have moved)
-      const Vec2 d = Vec2{near_x_[j], near_y_[j]} - p.pose.position();
+      // (its mean is still w.near's copy: only the seen ones have moved)
+      const Vec2 d = Vec2{w.near_x[j], w.near_y[j]} - p.pose.position();
       const Vec2 b{cy * d.x + sy * d.y, -sy * d.x + cy * d.y};
       const double b2 = squared_norm(b);
       const bool in_view = b2 < pr.view_range * pr.view_range && b.x > std::sqrt(b2) * cos_fov;
@@ -575,7 +597,7 @@ void FastSlam::expect_and_remove(Particle& p) {
                       static_cast<double>(s.lm.sightings) < pr.remove_ratio * static_cast<double>(s.lm.expected);
     const int misses = s.lm.confirmed ? pr.remove_misses : pr.remove_tentative_misses;
     if (rare || s.misses >= misses) {
-      p.live[static_cast<std::size_t>(near_live_[j])].alive &= ~(1u << (i % kLandmarkBlock));
+      p.live[static_cast<std::size_t>(w.near_live[j])].alive &= ~(1u << (i % kLandmarkBlock));
       died = true;
     }
   }
@@ -607,32 +629,32 @@ void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<
 }
 
 void FastSlam::update_particle(Particle& p, const Frame& f, bool copy_of_previous, double& log_lik,
-                               std::vector<std::int64_t>& ids) {
+                               std::vector<std::int64_t>& ids, const Eigen::Vector3d& draw, Scratch& w) {
   const bool v2 = params_.fastslam_version == 2;
   // FastSLAM 1.0: the pose from the motion model before anything else
   if (!v2) {
-    p.pose = sample_pose(p.pose, p.P);
+    p.pose = sample_pose(p.pose, p.P, draw);
     p.P.setZero();
   }
   // (2.0) an unchanged copy of the particle before it finds the same
   // landmarks near, the same association and the same proposal
   if (!(v2 && copy_of_previous)) {
-    gather_near(p);
-    associate(p, f);
-    if (v2) propose(p, f, match_);
+    gather_near(p, w);
+    associate(p, f, w);
+    if (v2) propose(p, f, w.match, w);
   }
   if (v2) {
-    log_lik += proposal_.log_lik;
-    p.pose = sample_pose(proposal_.mean, proposal_.cov);
+    log_lik += w.proposal.log_lik;
+    p.pose = sample_pose(w.proposal.mean, w.proposal.cov, draw);
     p.P.setZero();
   }
   // the associated landmarks' ids, before a removal may let their block go
-  ids.assign(match_.size(), -1);
-  for (std::size_t k = 0; k < match_.size(); ++k)
-    if (match_[k] >= 0) ids[k] = p.slot(near_[static_cast<std::size_t>(match_[k])]).lm.id;  // match_: positions in near_
-  update_landmarks(p, f, match_, log_lik);
-  expect_and_remove(p);
-  add_new_landmarks(p, f, match_, log_lik, ids);
+  ids.assign(w.match.size(), -1);
+  for (std::size_t k = 0; k < w.match.size(); ++k)
+    if (w.match[k] >= 0) ids[k] = p.slot(w.near[static_cast<std::size_t>(w.match[k])]).lm.id;  // match: positions in near
+  update_landmarks(p, f, w.match, log_lik, w);
+  expect_and_remove(p, w);
+  add_new_landmarks(p, f, w.match, log_lik, ids);
 }
 
 void FastSlam::resample() {

@@ -85,9 +85,13 @@
 // non-finite or absurd delta (over 1 km or 2 pi) are ignored and counted
 // (rejected()), never a crash.
 // Deterministic for a seed: its own std::mt19937_64, no global state.
-// Single-threaded (use_count() decides copy on write). A copy shares the
-// original's blocks, and their pool (which locks: the two may live in two
-// threads).
+// Threads (params.threads): the particles' update is split into contiguous
+// runs, one a thread, each with its own scratch; the pose draws are made
+// before, in the particles' order, so the result is bit for bit the same for
+// any count. A block shared by particles of two threads is cloned by
+// whichever writes it (use_count() decides copy on write; counts only fall
+// during an update). A copy of the filter shares the original's blocks and
+// their pool (which locks), and has threads of its own.
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -103,6 +107,7 @@
 #include "autonomy/common/geometry.h"
 #include "autonomy/hal/messages.h"
 #include "autonomy/common/params.h"
+#include "autonomy/common/workers.h"
 #include "autonomy/slam/cone_map.h"
 
 namespace paddock::slam {
@@ -183,6 +188,12 @@ struct FastSlamParams {
   // a camera colour vote outweighs a LiDAR intensity vote
   double camera_vote_weight = 3.0;
 
+  // threads sharing the particles' update (contiguous runs of them, each
+  // with its own scratch; the draws made before in the particles' order):
+  // the result is the same for any count. 1: the caller's thread alone (a
+  // sweep runs one run per core)
+  int threads = 1;
+
   template <class V>
   void visit(V& v) {
     v(PADDOCK_PARAM(fastslam_version), {"", params::in(1, 2), "1: FastSLAM 1.0 (motion-model proposal), 2: FastSLAM 2.0 (proposal folds the measurements in)"});
@@ -208,6 +219,7 @@ struct FastSlamParams {
     v(PADDOCK_PARAM(remove_tentative_misses), {"", params::in(1, 100000), "a tentative landmark is removed after this many expected frames in a row without a sighting"});
     v(PADDOCK_PARAM(resample_neff_ratio), {"", params::fraction(), "resample when N_eff < ratio * particles"});
     v(PADDOCK_PARAM(camera_vote_weight), {"", params::above_up_to(0.0, 1000.0), "weight of a camera colour vote (a LiDAR vote weighs 1)"});
+    v(PADDOCK_PARAM(threads), {"", params::in(1, Workers::kMaxThreads), "threads sharing the particles' update (the result is the same for any count)"});
   }
 };
 
@@ -405,22 +417,44 @@ class FastSlam {
     double log_lik;
   };
 
+  // one thread's scratch of update_particle (kept to spare the
+  // allocations): the landmarks near the particle (indices ascending, their
+  // blocks' positions in Particle::live, their means), where the
+  // observations land, the association's candidates and result
+  // (observation -> position in near or -1; near_taken: the near landmarks
+  // taken), the 2.0 proposal
+  struct Scratch {
+    std::vector<int> in_reach;  // live blocks (positions) within reach
+    std::vector<int> near;
+    std::vector<int> near_live;
+    std::vector<double> near_x, near_y;
+    std::vector<double> land_x, land_y;
+    std::vector<Candidate> cands, rivals;
+    std::vector<int> cands_per_obs, cands_per_near;
+    std::vector<int> match;
+    std::vector<char> near_taken;
+    Proposal proposal;
+  };
+
   void update_particle(Particle& p, const Frame& f, bool copy_of_previous, double& log_lik,
-                       std::vector<std::int64_t>& ids);
+                       std::vector<std::int64_t>& ids, const Eigen::Vector3d& draw, Scratch& w);
   // its parts, in order: the landmarks near the particle (into near_), the
   // association (observation -> position in near_ or -1; near_taken_:
   // the near landmarks taken), the 2.0 proposal (the pose is drawn from it
   // in update_particle), the associated landmarks' EKFs, the expectations
   // and removals, the new tentative landmarks
-  void gather_near(const Particle& p);
-  const std::vector<int>& associate(const Particle& p, const Frame& f);
-  void find_candidates(const Particle& p, const Frame& f);  // into cands_
-  void propose(const Particle& p, const Frame& f, const std::vector<int>& match);  // into proposal_
-  void update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik);
-  void expect_and_remove(Particle& p);
+  void gather_near(const Particle& p, Scratch& w);
+  const std::vector<int>& associate(const Particle& p, const Frame& f, Scratch& w);
+  void find_candidates(const Particle& p, const Frame& f, Scratch& w);  // into w.cands
+  void propose(const Particle& p, const Frame& f, const std::vector<int>& match, Scratch& w);  // into w.proposal
+  void update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik, Scratch& w);
+  void expect_and_remove(Particle& p, Scratch& w);
   void add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik,
                          std::vector<std::int64_t>& ids);
-  Pose2 sample_pose(const Pose2& mean, const Eigen::Matrix3d& cov);
+  // three standard normal draws of rng_ (a particle's, for its pose)
+  Eigen::Vector3d standard_normals();
+  // mean + L n, L L^T = cov (by the eigenvectors where cov is only semi-definite)
+  Pose2 sample_pose(const Pose2& mean, const Eigen::Matrix3d& cov, const Eigen::Vector3d& n);
   std::vector<Landmark> landmarks(bool confirmed_only) const;
 
   FastSlamParams params_;
@@ -467,16 +501,10 @@ class FastSlam {
   Frame frame_;
   const std::vector<float>* free_range_ = nullptr;  // update()'s free-space boundary, null if it hides nothing
   std::vector<double> log_lik_;
-  std::vector<int> in_reach_;   // live blocks (positions) within reach
-  std::vector<int> near_;       // the landmarks' indices, ascending
-  std::vector<int> near_live_;  // their blocks' positions in Particle::live
-  std::vector<double> near_x_, near_y_;
-  std::vector<double> land_x_, land_y_;  // where the observations land
-  std::vector<Candidate> cands_, rivals_;
-  std::vector<int> cands_per_obs_, cands_per_near_;
-  std::vector<int> match_;
-  std::vector<char> near_taken_;
-  Proposal proposal_;
+  std::vector<Eigen::Vector3d> draws_;  // per particle, this update's
+  // the particle update's threads (FastSlamParams::threads) and one scratch each
+  Workers workers_;
+  std::vector<Scratch> scratch_;
 };
 
 }  // namespace paddock::slam
