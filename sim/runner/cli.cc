@@ -10,9 +10,11 @@
 #include <cstdlib>
 #include <filesystem>
 #include <tuple>
+#include <charconv>
 #include <iostream>
 
 #include "autonomy/common/format.h"
+#include "autonomy/common/workers.h"
 #include "render/figures.h"
 #include "sim/runner/bench_compare.h"
 #include "sim/runner/files.h"
@@ -37,7 +39,7 @@ namespace {
 const char* kUsage =
     "usage:\n"
     "  paddock run SCENARIO.ini [--set section.key=value]... [--out DIR] [--json] [--quiet] [--log]\n"
-    "              [--profile] [--plots [PLOT OPTIONS]]\n"
+    "              [--profile] [--threads N] [--plots [PLOT OPTIONS]]\n"
     "      runs a scenario headless and prints the result; writes DIR/summary.json,\n"
     "      DIR/scenario.ini (resolved, defaults included) and DIR/log.csv\n"
     "      (DIR defaults to runs/<scenario name> in the current folder). --json prints\n"
@@ -48,6 +50,9 @@ const char* kUsage =
     "      --profile prints where the wall time went, by stage (physics, lidar,\n"
     "      camera, perception, localisation, planning, control, logging, scoring,\n"
     "      other; also in summary.json's \"profile\" always).\n"
+    "      --threads N runs on N threads, the same result: the camera renders beside\n"
+    "      the LiDAR's cast (--set sim.threads=2) and FastSLAM's particles are split\n"
+    "      N ways (--set slam.threads=N); a sweep keeps one run per core.\n"
     "      Exit 3 when [expect] fails.\n"
     "  paddock bench-compare OLD.json NEW.json   (./paddock bench compare OLD.json NEW.json)\n"
     "      two runs of the benchmarks (./paddock bench --json FILE) side by side: each\n"
@@ -191,6 +196,17 @@ int cmd_run(const std::vector<std::string>& args) {
     else if (a == "--quiet") quiet = true;
     else if (a == "--log") log = true;
     else if (a == "--profile") profile = true;
+    else if (a == "--threads") {
+      // the run on N threads: the camera beside the LiDAR, FastSLAM's particles split N ways
+      const std::string v = value("--threads");
+      int n = 0;
+      const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
+      if (ec != std::errc() || end != v.data() + v.size() || n < 1 || n > Workers::kMaxThreads)
+        throw UserError("--threads: expected a whole number of threads in [1, " + std::to_string(Workers::kMaxThreads) +
+                        "], got '" + v + "'");
+      overrides.push_back("sim.threads=" + std::to_string(std::min(n, 2)));
+      overrides.push_back("slam.threads=" + std::to_string(n));
+    }
     else if (!a.empty() && a[0] == '-') throw UserError("unknown option " + a + "\n" + kUsage);
     else if (scenario_path.empty()) scenario_path = a;
     else throw UserError("more than one scenario given: " + scenario_path + " and " + a);

@@ -20,8 +20,8 @@ std::vector<bool> cones_hit(const std::vector<std::int32_t>& truth, std::size_t 
 RawSensors::RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
                        const std::vector<world::Block>& blocks, const std::optional<sensors::CameraParams>& camera,
                        const sensors::DetectorParams& detector, std::uint64_t lidar_seed, std::uint64_t camera_seed,
-                       std::uint64_t detector_seed)
-    : lidar_(lidar, lidar_seed), ground_(ground), blocks_(blocks) {
+                       std::uint64_t detector_seed, int threads)
+    : workers_(camera && threads > 1 ? 2 : 1), lidar_(lidar, lidar_seed), ground_(ground), blocks_(blocks) {
   if (!camera) return;
   camera_ = std::make_unique<sensors::Camera>(*camera, camera_seed);
   detector_ = std::make_unique<sensors::AnnotationDetector>(detector, detector_seed);
@@ -86,31 +86,52 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
     update_scene(cones, faults, t);
   }
   const TimeNs start = now - lidar_.period_ns();
-  if (camera_ && !faults.camera_dead(t)) {
-    const StageScope scope(profile_, Stage::Camera);
-    const TimeNs exposure = sensors::trigger_time(lidar_.params(), camera_->params().trigger_azimuth, start);
-    if (frozen_ && faults.camera_frozen(t)) {
-      // the same image again, stamped anew: the node finds the same boxes on it
-      hal::CameraDetections again = *frozen_;
-      again.stamp = exposure;
-      hal.post(std::move(again));
-    } else {
-      camera_->render(*world_, poses.at(exposure), exposure, frame_, annotation_);
-      // the detector node's boxes on it, as the car's posts them (a frame it
-      // cannot read gives none, as a node that fails posts nothing)
-      sensors::AnnotationDetection d = detector_->detect(frame_, annotation_);
-      if (d.ok) {
-        frozen_ = d.detections;
-        hal.post(std::move(d.detections));
+  const bool camera_on = camera_ && !faults.camera_dead(t);
+  // a frozen camera posts the same image again; a live one renders
+  const bool frozen = camera_on && frozen_ && faults.camera_frozen(t);
+  const bool render = camera_on && !frozen;
+  const bool lidar_on = faults.lidar_sends(t);
+  const TimeNs exposure =
+      camera_on ? sensors::trigger_time(lidar_.params(), camera_->params().trigger_azimuth, start) : TimeNs{0};
+  // the detector node's boxes on the frame (a frame it cannot read gives
+  // none, as a node that fails posts nothing)
+  std::optional<sensors::AnnotationDetection> detection;
+  const auto shoot = [&] {
+    camera_->render(*world_, poses.at(exposure), exposure, frame_, annotation_);
+    detection = detector_->detect(frame_, annotation_);
+  };
+  std::vector<sensors::LidarPoint> raw;
+  const auto cast = [&] { raw = lidar_.scan(*world_, [&poses](TimeNs at) { return poses.at(at); }, start); };
+  bool cast_done = false;
+  if (render && lidar_on && workers_.threads() > 1) {
+    const StageScope scope(profile_, Stage::Camera);  // what the camera takes beyond the cast
+    workers_.run([&](int part) {
+      if (part == 0) {
+        const StageScope lidar(profile_, Stage::Lidar);
+        cast();
+      } else {
+        shoot();
       }
-    }
+    });
+    cast_done = true;
+  } else if (render) {
+    const StageScope scope(profile_, Stage::Camera);
+    shoot();
   }
-  if (!faults.lidar_sends(t)) {
+  if (frozen) {
+    hal::CameraDetections again = *frozen_;
+    again.stamp = exposure;
+    hal.post(std::move(again));
+  } else if (detection && detection->ok) {
+    frozen_ = detection->detections;
+    hal.post(std::move(detection->detections));
+  }
+  if (!lidar_on) {
     truth_.clear();
     return truth_;
   }
   const StageScope scope(profile_, Stage::Lidar);
-  std::vector<sensors::LidarPoint> raw = lidar_.scan(*world_, [&poses](TimeNs at) { return poses.at(at); }, start);
+  if (!cast_done) cast();
   faults.filter_lidar(t, raw);
   truth_.resize(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) truth_[i] = raw[i].cone;

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "autonomy/common/profile.h"
+#include "autonomy/common/workers.h"
 #include "autonomy/hal/messages.h"
 #include "sim/runner/faults.h"
 #include "sim/runner/sim_hal.h"
@@ -55,7 +56,8 @@ class RawSensors {
   // camera and the detector each draw from their own random stream
   RawSensors(const sensors::LidarParams& lidar, const sensors::GroundParams& ground,
              const std::vector<world::Block>& blocks, const std::optional<sensors::CameraParams>& camera, const sensors::DetectorParams& detector,
-             std::uint64_t lidar_seed, std::uint64_t camera_seed, std::uint64_t detector_seed);
+             std::uint64_t lidar_seed, std::uint64_t camera_seed, std::uint64_t detector_seed,
+             int threads = 1);
 
   // true when a rotation ends at `now` (one starts at 0, then every period)
   bool rotation_ends(TimeNs now) const;
@@ -74,7 +76,9 @@ class RawSensors {
   TimeNs scan_end(TimeNs now) const;
   // the last camera frame rendered (for the perception figures), or null
   const hal::CameraFrame* camera_frame() const { return camera_ && frame_.width > 0 ? &frame_ : nullptr; }
-  // the LiDAR's and the camera's time, timed into `profile` (null: not timed)
+  // the LiDAR's and the camera's time, timed into `profile` (null: not timed).
+  // With two threads the camera's is the time the loop waits for it beyond
+  // the LiDAR's cast
   void set_profile(Profile* profile) { profile_ = profile; }
 
  private:
@@ -83,6 +87,10 @@ class RawSensors {
   // the blocks (the venue's and a fault's object): rebuilt when they changed
   void update_scene(const world::ConeWorld& cones, const FaultInjector& faults, double t);
 
+  // threads = 2: the camera's render and detector on the second (each
+  // sensor draws from its own stream, the scene is only read, and the
+  // detections are posted before the scan as on one thread)
+  Workers workers_;
   sensors::Lidar lidar_;
   std::unique_ptr<sensors::Camera> camera_;
   std::unique_ptr<sensors::AnnotationDetector> detector_;

@@ -187,7 +187,8 @@ std::unique_ptr<RawSensors> make_raw_sensors(const SimModel& model) {
   const Scenario& scenario = model.scenario;
   const std::uint64_t seed = scenario.scenario.seed;
   return std::make_unique<RawSensors>(scenario.lidar, scenario.ground, model.blocks, model.camera, scenario.detector,
-                                      stream_seed(seed, "lidar"), stream_seed(seed, "camera"), stream_seed(seed, "detector"));
+                                      stream_seed(seed, "lidar"), stream_seed(seed, "camera"), stream_seed(seed, "detector"),
+                                      scenario.sim.threads);
 }
 
 // what the run leaves behind besides the observers' records: the event's
