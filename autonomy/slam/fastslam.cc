@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
-#include <new>
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
@@ -130,44 +129,7 @@ double FastSlam::Bounds::squared_distance(Vec2 c) const {
   return dx * dx + dy * dy;
 }
 
-FastSlam::BlockPool::~BlockPool() {
-  for (void* p : free_) ::operator delete(p);
-}
-
-void* FastSlam::BlockPool::take(std::size_t bytes) {
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (bytes_ == 0) bytes_ = bytes;
-    if (bytes == bytes_ && !free_.empty()) {
-      void* p = free_.back();
-      free_.pop_back();
-      return p;
-    }
-  }
-  return ::operator new(bytes);
-}
-
-void FastSlam::BlockPool::give(void* p, std::size_t bytes) {
-  {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    if (bytes == bytes_ && free_.size() < free_.capacity()) {
-      free_.push_back(p);  // no allocation here: a deallocation must not throw
-      return;
-    }
-    if (bytes == bytes_) {
-      try {
-        free_.reserve(2 * free_.capacity() + 64);
-        free_.push_back(p);
-        return;
-      } catch (const std::bad_alloc&) {
-        // no room to keep it: back to the heap
-      }
-    }
-  }
-  ::operator delete(p);
-}
-
-FastSlam::Slot& FastSlam::Particle::mutable_slot(int i, const BlockAlloc& a) {
+FastSlam::Slot& FastSlam::Particle::mutable_slot(int i) {
   BlockRef& ref = blocks[static_cast<std::size_t>(i / kLandmarkBlock)];
   std::shared_ptr<Block>& b = live[static_cast<std::size_t>(ref.live)].block;
   // with the particles split between threads, another may just have let go
@@ -176,23 +138,23 @@ FastSlam::Slot& FastSlam::Particle::mutable_slot(int i, const BlockAlloc& a) {
   const long holders = b.use_count();
   std::atomic_thread_fence(std::memory_order_acquire);
   if (holders > 1) {
-    b = std::allocate_shared<Block>(a, *b);  // copy on write
+    b = std::make_shared<Block>(*b);  // copy on write
     ref.block = b.get();
   }
   return b->slots[i % kLandmarkBlock];
 }
 
-int FastSlam::Particle::add(const Slot& s, const BlockAlloc& a) {
+int FastSlam::Particle::add(const Slot& s) {
   const int i = size++;
   const int b = i / kLandmarkBlock;
   if (b == static_cast<int>(blocks.size())) blocks.push_back({nullptr, -1});
   BlockRef& ref = blocks[static_cast<std::size_t>(b)];
   if (!ref.block) {
     // a new block, or the last one again after its slots so far all died
-    live.push_back({std::allocate_shared<Block>(a), b, 0u, Bounds{}});
+    live.push_back({std::make_shared<Block>(), b, 0u, Bounds{}});
     ref = {live.back().block.get(), static_cast<int>(live.size()) - 1};
   }
-  mutable_slot(i, a) = s;
+  mutable_slot(i) = s;
   LiveBlock& lb = live.back();  // the last block is the last live one
   lb.alive |= 1u << (i % kLandmarkBlock);
   lb.bounds.cover(s.lm.mean);
@@ -547,7 +509,7 @@ void FastSlam::update_landmarks(Particle& p, const Frame& f, const std::vector<i
     if (match[k] < 0) continue;
     const Observation& o = *f.obs[k];
     const std::size_t j = static_cast<std::size_t>(match[k]);
-    Slot& s = p.mutable_slot(w.near[j], block_alloc_);
+    Slot& s = p.mutable_slot(w.near[j]);
     Landmark& lm = s.lm;
     const Predicted h = predict_measurement(p.pose, lm.mean);
     const Matrix2d S = h.Hm * lm.cov * h.Hm.transpose() + f.R[k];
@@ -590,7 +552,7 @@ void FastSlam::expect_and_remove(Particle& p, Scratch& w) {
         if (std::sqrt(b2) > static_cast<double>(edge) + pr.occlusion_margin) continue;
       }
     }
-    Slot& s = p.mutable_slot(i, block_alloc_);
+    Slot& s = p.mutable_slot(i);
     ++s.lm.expected;
     if (!seen) ++s.misses;
     const bool rare = s.lm.expected >= pr.remove_min_expected &&
@@ -624,7 +586,7 @@ void FastSlam::add_new_landmarks(Particle& p, const Frame& f, const std::vector<
     s.lm.expected = 1;
     s.lm.votes[static_cast<std::size_t>(o.color)] += o.colour_from_camera ? pr.camera_vote_weight : 1.0;
     s.lm.confirmed = s.lm.sightings >= pr.confirm_sightings;
-    p.add(s, block_alloc_);
+    p.add(s);
   }
 }
 
@@ -733,7 +695,7 @@ void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int6
       const auto it = std::lower_bound(sorted.begin(), sorted.end(), id,
                                        [](const auto& a, std::int64_t k) { return a.first < k; });
       if (it == sorted.end() || it->first != id || !finite(it->second)) continue;
-      best.mutable_slot(i, block_alloc_).lm.mean = it->second;
+      best.mutable_slot(i).lm.mean = it->second;
       lb.bounds.cover(it->second);  // the box grows to the moved mean (a bound, never too small)
     }
   }

@@ -90,13 +90,12 @@
 // before, in the particles' order, so the result is bit for bit the same for
 // any count. A block shared by particles of two threads is cloned by
 // whichever writes it (use_count() decides copy on write; counts only fall
-// during an update). A copy of the filter shares the original's blocks and
-// their pool (which locks), and has threads of its own.
+// during an update). A copy of the filter shares the original's blocks, and
+// has threads of its own.
 #include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
-#include <mutex>
 #include <random>
 #include <utility>
 #include <vector>
@@ -306,41 +305,6 @@ class FastSlam {
   struct Block {
     std::array<Slot, kLandmarkBlock> slots;
   };
-  // The blocks' memory. An update clones a thousand blocks or so (the
-  // particles' writes to shared ones) and a resample lets as many go: a free
-  // list of the one size allocate_shared asks for (a block and its
-  // reference counts) keeps them off the heap once the filter has run a
-  // while. Its allocators share it: it lives as long as a block does. A
-  // copy of the filter shares it too (with the blocks), hence the lock.
-  class BlockPool {
-   public:
-    BlockPool() = default;
-    BlockPool(const BlockPool&) = delete;
-    BlockPool& operator=(const BlockPool&) = delete;
-    ~BlockPool();
-    void* take(std::size_t bytes);
-    void give(void* p, std::size_t bytes);
-
-   private:
-    std::mutex mutex_;
-    std::size_t bytes_ = 0;  // the size it keeps (the first asked for)
-    std::vector<void*> free_;
-  };
-  template <class T>
-  struct BlockAllocator {
-    using value_type = T;
-    std::shared_ptr<BlockPool> pool;
-    explicit BlockAllocator(std::shared_ptr<BlockPool> p) : pool(std::move(p)) {}
-    template <class U>
-    BlockAllocator(const BlockAllocator<U>& o) : pool(o.pool) {}  // NOLINT: the rebind std::allocate_shared needs
-    T* allocate(std::size_t n) { return static_cast<T*>(pool->take(n * sizeof(T))); }
-    void deallocate(T* p, std::size_t n) { pool->give(p, n * sizeof(T)); }
-    template <class U>
-    bool operator==(const BlockAllocator<U>& o) const { return pool == o.pool; }
-    template <class U>
-    bool operator!=(const BlockAllocator<U>& o) const { return pool != o.pool; }
-  };
-  using BlockAlloc = BlockAllocator<Block>;
   // a box holding every landmark mean a block has held (it only grows: a
   // mean moves by centimetres, a dead slot stays in it); a block whose box
   // is out of a frame's reach is skipped without reading it
@@ -383,8 +347,8 @@ class FastSlam {
     std::vector<BlockRef> blocks;                // by number
     int size = 0;                                // slots used
     const Slot& slot(int i) const { return blocks[i / kLandmarkBlock].block->slots[i % kLandmarkBlock]; }
-    Slot& mutable_slot(int i, const BlockAlloc& a);  // clones a shared block first (from a)
-    int add(const Slot& s, const BlockAlloc& a);     // a new alive slot
+    Slot& mutable_slot(int i);                   // clones a shared block first
+    int add(const Slot& s);                      // a new alive slot
     void sweep();                                // lets go of the live blocks with no alive slot left
   };
   // an update's valid observations: range and bearing, noise, the
@@ -459,7 +423,6 @@ class FastSlam {
 
   FastSlamParams params_;
   std::mt19937_64 rng_;
-  BlockAlloc block_alloc_{std::make_shared<BlockPool>()};
   std::vector<Particle> particles_;
   int best_ = 0;
   double neff_ = 0.0;
