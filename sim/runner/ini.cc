@@ -40,6 +40,14 @@ bool valid_name(std::string_view s) {
   });
 }
 
+// the folder a file's includes are read from: its own, "." for a bare
+// name in the current folder (its parent_path() is empty, and an empty base
+// is how text that is no file says it may include nothing)
+fs::path folder_of(const fs::path& file) {
+  const fs::path dir = file.parent_path();
+  return dir.empty() ? fs::path(".") : dir;
+}
+
 class Reader {
  public:
   std::vector<IniEntry> entries;
@@ -104,7 +112,7 @@ class Reader {
       throw UserError(where + ": cannot include " + e.what());
     }
     stack_.push_back(id);
-    parse(text, path.string(), path.parent_path());
+    parse(text, path.string(), folder_of(path));
     stack_.pop_back();
   }
 
@@ -124,7 +132,7 @@ std::vector<IniEntry> read_ini_file(const std::string& path) {
   std::error_code ec;
   const fs::path canon = fs::weakly_canonical(fs::path(path), ec);
   r.start(ec ? path : canon.string());
-  r.parse(text, path, fs::path(path).parent_path());
+  r.parse(text, path, folder_of(fs::path(path)));
   return r.entries;
 }
 

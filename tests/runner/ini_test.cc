@@ -92,6 +92,30 @@ TEST_F(IniFiles, IncludeIsRelativeToTheIncludingFileAndLaterEntriesWin) {
   EXPECT_EQ(e[2].line, 3);
 }
 
+// a file named bare, in the current folder (paddock run my.ini from where it
+// lies): its includes and theirs are read from there
+TEST_F(IniFiles, AFileInTheCurrentFolderIncludesRelativeToIt) {
+  write("sub/vehicle.ini", "[v]\nmass = 190\n");
+  write("mid.ini", "include = sub/vehicle.ini\n[v]\nlf = 0.7\n");
+  write("top.ini", "include = mid.ini\n[v]\nmass = 200\n");
+  const fs::path before = fs::current_path();
+  fs::current_path(dir_);
+  std::vector<IniEntry> e;
+  std::string error;
+  try {
+    e = read_ini_file("top.ini");
+  } catch (const UserError& x) {
+    error = x.what();
+  }
+  fs::current_path(before);
+  ASSERT_EQ(error, "");
+  ASSERT_EQ(e.size(), 3u);
+  EXPECT_EQ(e[0].value, "190");
+  EXPECT_EQ(e[0].file, "sub/vehicle.ini");
+  EXPECT_EQ(e[1].file, "mid.ini");
+  EXPECT_EQ(e[2].value, "200");
+}
+
 TEST_F(IniFiles, IncludeInsideASectionReturnsToThatSection) {
   write("sub/part.ini", "[other]\nk = 1\n");
   const auto top = write("top.ini", "[mine]\ninclude = sub/part.ini\nafter = 2\n");
