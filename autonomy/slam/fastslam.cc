@@ -1,7 +1,6 @@
 #include "autonomy/slam/fastslam.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -131,15 +130,12 @@ double FastSlam::Bounds::squared_distance(Vec2 c) const {
 
 FastSlam::Slot& FastSlam::Particle::mutable_slot(int i) {
   BlockRef& ref = blocks[static_cast<std::size_t>(i / kLandmarkBlock)];
-  std::shared_ptr<Block>& b = live[static_cast<std::size_t>(ref.live)].block;
-  // with the particles split between threads, another may just have let go
-  // of this block (its clone made): a count of 1 read here is ordered after
-  // that thread's reads of it by the fence (its release is a release)
-  const long holders = b.use_count();
-  std::atomic_thread_fence(std::memory_order_acquire);
-  if (holders > 1) {
+  LiveBlock& lb = live[static_cast<std::size_t>(ref.live)];
+  std::shared_ptr<Block>& b = lb.block;
+  if (sharing_fixed ? lb.shared : b.use_count() > 1) {
     b = std::make_shared<Block>(*b);  // copy on write
     ref.block = b.get();
+    lb.shared = false;
   }
   return b->slots[i % kLandmarkBlock];
 }
@@ -290,6 +286,14 @@ void FastSlam::update(const std::vector<Observation>& obs, const std::vector<flo
   for (Vector3d& d : draws_) d = standard_normals();
   const int parts = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(workers_.threads()), n));
   scratch_.resize(static_cast<std::size_t>(workers_.threads()));
+  if (parts > 1) {
+    // which blocks are shared, fixed now for the update (no reference is
+    // taken during one: the counts only fall)
+    for (Particle& p : particles_) {
+      p.sharing_fixed = true;
+      for (LiveBlock& lb : p.live) lb.shared = lb.block.use_count() > 1;
+    }
+  }
   workers_.run([&](int part) {
     if (part >= parts) return;
     const auto [begin, end] = Workers::range(n, parts, part);
@@ -301,7 +305,10 @@ void FastSlam::update(const std::vector<Observation>& obs, const std::vector<flo
                       frame_ids_[i], draws_[i], w);
     }
   });
-  for (Particle& p : particles_) p.copy_of = -1;  // each drew its own pose
+  for (Particle& p : particles_) {
+    p.copy_of = -1;  // each drew its own pose
+    p.sharing_fixed = false;
+  }
 
   // reweight (in logs, about the largest, against underflow) and normalise
   const double top = *std::max_element(ll.begin(), ll.end());

@@ -88,10 +88,10 @@
 // Threads (params.threads): the particles' update is split into contiguous
 // runs, one a thread, each with its own scratch; the pose draws are made
 // before, in the particles' order, so the result is bit for bit the same for
-// any count. A block shared by particles of two threads is cloned by
-// whichever writes it (use_count() decides copy on write; counts only fall
-// during an update). A copy of the filter shares the original's blocks, and
-// has threads of its own.
+// any count. Copy on write: a block shared when a threaded update began is
+// cloned by every particle that writes it (Particle::sharing_fixed); on one
+// thread, by every writer while use_count() > 1. A copy of the filter shares
+// the original's blocks, and has threads of its own.
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -328,6 +328,9 @@ class FastSlam {
     int number;
     std::uint32_t alive;
     Bounds bounds;
+    // held by another particle when a threaded update began (see
+    // Particle::sharing_fixed)
+    bool shared = false;
   };
   static_assert(kLandmarkBlock <= 32, "LiveBlock::alive holds a block's slots");
   // a block by number, for reading: its live entry's block and position
@@ -343,6 +346,14 @@ class FastSlam {
     // the parent's index while an unchanged copy from a resample (its
     // copies are consecutive), -1 once updated
     int copy_of = -1;
+    // during an update split between threads: whether a block is shared
+    // (written as a clone) is what it was when the update began
+    // (LiveBlock::shared), not its use count now. Another thread's particle
+    // may let go of a block meanwhile, and its reads of it must not meet a
+    // write in place here; a block shared then is never written in place
+    // during the update, one not shared then is this particle's alone. Alone
+    // on one thread the count decides (the last holder writes in place)
+    bool sharing_fixed = false;
     std::vector<LiveBlock> live;                 // by number
     std::vector<BlockRef> blocks;                // by number
     int size = 0;                                // slots used
@@ -402,11 +413,10 @@ class FastSlam {
 
   void update_particle(Particle& p, const Frame& f, bool copy_of_previous, double& log_lik,
                        std::vector<std::int64_t>& ids, const Eigen::Vector3d& draw, Scratch& w);
-  // its parts, in order: the landmarks near the particle (into near_), the
-  // association (observation -> position in near_ or -1; near_taken_:
-  // the near landmarks taken), the 2.0 proposal (the pose is drawn from it
-  // in update_particle), the associated landmarks' EKFs, the expectations
-  // and removals, the new tentative landmarks
+  // its parts, in order: the landmarks near the particle (into w.near), the
+  // association (into w.match and w.near_taken), the 2.0 proposal (the pose
+  // is drawn from it in update_particle), the associated landmarks' EKFs,
+  // the expectations and removals, the new tentative landmarks
   void gather_near(const Particle& p, Scratch& w);
   const std::vector<int>& associate(const Particle& p, const Frame& f, Scratch& w);
   void find_candidates(const Particle& p, const Frame& f, Scratch& w);  // into w.cands
