@@ -330,9 +330,8 @@ double Stack::finish_approach_cap(Vec2 base) const {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   if (spec_.finish_crossings <= 0 || telemetry_.finish_crossings != spec_.finish_crossings - 1 || trajectory_.empty())
     return kInf;
-  // braking at stop_decel_max to the finish speed that stops in stop_distance
-  const double a = mp.stop_decel_max;
-  const double v_finish2 = 2.0 * a * mp.stop_distance;
+  // braking at stop_decel_max (less in turns) to the finish speed that stops
+  // in stop_distance
   const TrajectoryProjection car = project(trajectory_, base, 0.0, 0.0);
   double cap = kInf;
   for (const Segment& g : gates_) {
@@ -341,9 +340,42 @@ double Stack::finish_approach_cap(Vec2 base) const {
     double ahead = gate.s - car.s;
     if (trajectory_.closed && ahead < 0.0) ahead += trajectory_.length;
     if (ahead < 0.0) continue;
-    cap = std::min(cap, std::sqrt(v_finish2 + 2.0 * a * ahead));
+    cap = std::min(cap, stop_speed_cap(car.s, ahead + mp.stop_distance, mp.stop_decel_max));
   }
   return cap;
+}
+
+double Stack::stop_speed_cap(double s, double to_rest, double a) const {
+  // the velocity profile's backward pass with braking alone, from rest at
+  // s + to_rest: v^2 grows by 2 d ds going back, d = sqrt(a^2 - (v^2 kappa)^2)
+  // (none where the turn takes all of a: there the cap stays under
+  // sqrt(a / |kappa|)); an open path's last curvature goes on past its end
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double top = 0.0;
+  for (const TrajectoryPoint& p : trajectory_.points) top = std::max(top, p.speed);
+  constexpr double kStep = 0.25;  // m
+  const int steps = std::max(1, static_cast<int>(std::ceil(to_rest / kStep)));
+  const double h = to_rest / steps;
+  double v2 = 0.0;
+  for (int k = steps - 1; k >= 0; --k) {
+    const double kappa = trajectory_.at(s + (k + 0.5) * h).curvature;
+    const double ay = v2 * std::abs(kappa);
+    v2 += 2.0 * std::sqrt(std::max(0.0, a * a - ay * ay)) * h;
+    if (v2 > top * top) return kInf;  // above the whole trajectory: binds nowhere
+  }
+  return std::sqrt(v2);
+}
+
+double Stack::stop_deceleration(const hal::StateEstimate& st, double nominal) const {
+  // the grip the turn leaves (friction circle of radius stop_decel_max), but
+  // never under a floor: a stop in a turn that takes all of it still ends
+  const MissionParams& mp = params_.mission;
+  if (trajectory_.empty()) return nominal;
+  const double a = std::max(mp.stop_decel, mp.stop_decel_max);
+  const double kappa = project(trajectory_, st.pose.position(), 0.0, 0.0).ref.curvature;
+  const double ay = st.vx * st.vx * std::abs(kappa);
+  const double floor = 0.1 * mp.stop_decel;
+  return std::clamp(std::sqrt(std::max(0.0, a * a - ay * ay)), std::min(floor, nominal), nominal);
 }
 
 void Stack::start_stopping(TimeNs now, double speed) {
@@ -351,6 +383,7 @@ void Stack::start_stopping(TimeNs now, double speed) {
   telemetry_.stopping = true;
   stop_start_ = now;
   stop_speed_ = std::max(speed, 0.0);
+  stop_held_ = 0.0;
 }
 
 bool Stack::gate_still_seen(const Segment& g) const {
@@ -549,7 +582,10 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
   if (telemetry_.stopping) {
     const double decel = std::clamp(stop_speed_ * stop_speed_ / (2.0 * mp.stop_distance), mp.stop_decel,
                                     std::max(mp.stop_decel, mp.stop_decel_max));
-    max_speed = std::max(0.0, stop_speed_ - decel * to_seconds(now - stop_start_));
+    // what the turn's grip held back is given up by the ramp (nothing on a
+    // straight: the ramp is then exactly decel * t)
+    stop_held_ += (decel - stop_deceleration(st, decel)) * dt;
+    max_speed = std::max(0.0, stop_speed_ - decel * to_seconds(now - stop_start_) + stop_held_);
   } else {
     max_speed = finish_approach_cap(st.pose.position());
   }

@@ -66,7 +66,10 @@ struct MissionParams {
   // stop_decel_max; on the last lap the car approaches the finish no faster
   // than it can stop from in stop_distance at stop_decel_max (braking to it
   // at stop_decel_max). The rules allow 30 m; the rest of them is for the
-  // speed loop's lag and the braking's build-up.
+  // speed loop's lag and the braking's build-up. Both share the grip with
+  // the turn: braking and the path's v^2 |kappa| stay within a friction
+  // circle of radius stop_decel_max (a finish in mid-corner is approached
+  // slower, and the stop brakes less while the path still turns).
   double stop_decel = 8.0;
   double stop_distance = 20.0;
   double stop_decel_max = 12.0;
@@ -253,6 +256,13 @@ class Stack {
   // on the last lap: the fastest speed from which the car can still brake to
   // the finish speed that stops within the stop distance (infinite otherwise)
   double finish_approach_cap(Vec2 base) const;
+  // the highest speed at arc length s of the trajectory from which the car
+  // brakes to rest within `to_rest` metres further along it, braking and the
+  // path's turn sharing a friction circle of radius a (infinite when above
+  // every speed of the trajectory)
+  double stop_speed_cap(double s, double to_rest, double a) const;
+  // the stop's deceleration now: `nominal` where the turn leaves it the grip
+  double stop_deceleration(const hal::StateEstimate& st, double nominal) const;
   // the lap that just took over, ramped up from the car's speed
   void catch_up(const hal::StateEstimate& st);
   void count_crossings(Vec2 base, TimeNs now, double speed);
@@ -314,6 +324,8 @@ class Stack {
   std::optional<TimeNs> last_tick_;
   TimeNs stop_start_ = 0;
   double stop_speed_ = 0.0;
+  // the speed the stop's ramp gave up to the turn's grip so far (m/s)
+  double stop_held_ = 0.0;
 };
 
 const char* to_string(Mission m);

@@ -173,6 +173,61 @@ TEST(Stack, CountsFinishCrossingsThenStopsAndFinishes) {
   EXPECT_EQ(s.telemetry().fallbacks, 0);
 }
 
+// the stop after a finish in mid-turn shares the grip with the turn: on a
+// circle driven at 11 m/s^2 of lateral acceleration, the stop's braking must
+// keep the car within the friction circle of radius stop_decel_max = 12 m/s^2
+// (sqrt(12^2 - 11^2) = 4.8 m/s^2 of braking at first: a stop ramped at the
+// straight-line 8 m/s^2 would ask for 13.6 m/s^2, and a real car slides out)
+TEST(Stack, TheStopAfterAFinishInATurnStaysWithinTheGrip) {
+  StackParams p = oracle_params();
+  p.planning.reference.profile.ay_max = 11.0;
+  p.planning.reference.profile.ax_max = 12.0;
+  p.planning.reference.profile.ax_brake_max = 12.0;
+  p.planning.reference.profile.turn_accel_scale = 1.0;
+  const double a_grip = p.mission.stop_decel_max;
+  const double R = 20.0;
+  Stack s(p, circle_mission(3));  // start line, then two laps
+  ScriptedHal hal;
+  double x = -2.0, y = 0.0, yaw = 0.0, v = 0.0;
+  const double L = p.vehicle.wheelbase;
+  double worst = 0.0, v_at_stop = -1.0;
+  bool finished = false;
+  for (int k = 0; k < 100 * 120 && !finished; ++k) {
+    const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
+    hal.inbox.push_back(state_at(t, {x, y}, yaw, v));
+    if (k == 10) hal.inbox.push_back(hal::ResSignal{t, true, false});
+    s.tick(t, hal);
+    const auto& c = hal.sent.back();
+    finished = c.as_state == hal::AsState::Finished;
+    // the car follows the circle (its path's turn, v^2 / R, is the lateral
+    // acceleration); its pedals and resistances are the speed loop's model
+    // of it (control::SpeedModel's defaults), so that the loop's braking is
+    // the braking it asks for
+    const control::SpeedModel car;
+    const double v0 = v;
+    for (int i = 0; i < 10; ++i) {
+      const double dt = 1e-3;
+      const double f = car.max_drive_force * c.throttle - car.max_brake_force * c.brake -
+                       car.drag_coefficient * v * v - (v > 0.0 ? car.rolling_resistance : 0.0);
+      x += v * std::cos(yaw) * dt;
+      y += v * std::sin(yaw) * dt;
+      yaw += v * std::tan(c.steering_angle) / L * dt;
+      v = std::max(0.0, v + f / car.mass * dt);
+    }
+    if (s.telemetry().stopping) {
+      if (v_at_stop < 0.0) v_at_stop = v0;
+      // the cycle's mean deceleration against the turn's demand at its start
+      const double ax = (v0 - v) / 0.01;
+      if (v > 0.0) worst = std::max(worst, std::hypot(ax, v0 * v0 / R));
+    }
+  }
+  ASSERT_TRUE(finished);
+  EXPECT_GT(v_at_stop * v_at_stop / R, 0.75 * 11.0);  // the stop began in the turn, near its grip
+  // within the circle, but for the speed loop's overshoot of one cycle
+  EXPECT_LT(worst, a_grip * 1.05);
+  EXPECT_EQ(s.telemetry().fallbacks, 0);
+}
+
 // blue cones at y = 1.75 and yellow at y = -1.75, every 3 m from x = -6 to x_last
 std::vector<Cone> corridor(double x_last) {
   std::vector<Cone> track;
