@@ -25,7 +25,7 @@ void Odometry::add(const hal::Imu& imu) {
   w_ = imu.yaw_rate;
   has_w_ = true;
   if (!knots_.empty() && knots_.back().stamp == imu.stamp) knots_.back().w = w_;
-  if (knots_.empty() && has_v_) knots_.push_back({imu.stamp, Pose2{}, v_, w_});
+  if (knots_.empty() && has_v_) knots_.push_back({imu.stamp, Pose2{}, v_, w_, u_});
 }
 
 void Odometry::add(const hal::WheelSpeeds& wheels) {
@@ -39,7 +39,18 @@ void Odometry::add(const hal::WheelSpeeds& wheels) {
   v_ = 0.5 * (rl + rr) * params_.wheel_radius;
   has_v_ = true;
   if (!knots_.empty() && knots_.back().stamp == wheels.stamp) knots_.back().v = v_;
-  if (knots_.empty() && has_w_) knots_.push_back({wheels.stamp, Pose2{}, v_, w_});
+  if (knots_.empty() && has_w_) knots_.push_back({wheels.stamp, Pose2{}, v_, w_, u_});
+}
+
+void Odometry::add(const hal::StateEstimate& estimate) {
+  if (!params_.lateral_velocity) return;
+  if (!finite(estimate.vy)) {
+    ++rejected_;
+    return;
+  }
+  if (!any_ || estimate.stamp >= newest_) step(estimate.stamp);
+  u_ = estimate.vy;
+  if (!knots_.empty() && knots_.back().stamp == newest_) knots_.back().u = u_;
 }
 
 void Odometry::step(TimeNs stamp) {
@@ -49,7 +60,7 @@ void Odometry::step(TimeNs stamp) {
   const Knot& last = knots_.back();
   if (stamp > last.stamp) {
     // advance with the held values; the caller then stores the new value
-    knots_.push_back({stamp, arc(last, to_seconds(stamp - last.stamp)), v_, w_});
+    knots_.push_back({stamp, arc(last, to_seconds(stamp - last.stamp)), v_, w_, u_});
   }
   // forget knots older than the history, keeping one at or before its start
   const TimeNs horizon = stamp - from_seconds(params_.history);
@@ -57,12 +68,15 @@ void Odometry::step(TimeNs stamp) {
 }
 
 Pose2 Odometry::arc(const Knot& k, double dt) {
-  // exact integration at constant v and w: the chord of the arc has length
-  // v dt sinc(w dt / 2) and points along the mean heading yaw + w dt / 2
+  // exact integration at constant v, u and w: the body-frame velocity (v, u)
+  // turns with the base, so the displacement is (v, u) dt sinc(w dt / 2)
+  // turned to the mean heading yaw + w dt / 2 (the chord of the arc)
   const double dyaw = k.w * dt;
-  const double chord = k.v * dt * sinc(0.5 * dyaw);
+  const double f = dt * sinc(0.5 * dyaw);
+  const double along = k.v * f, across = k.u * f;
   const double mid = k.pose.yaw + 0.5 * dyaw;
-  return {k.pose.x + chord * std::cos(mid), k.pose.y + chord * std::sin(mid), k.pose.yaw + dyaw};
+  const double c = std::cos(mid), s = std::sin(mid);
+  return {k.pose.x + (along * c - across * s), k.pose.y + (along * s + across * c), k.pose.yaw + dyaw};
 }
 
 std::optional<Pose2> Odometry::pose_at(TimeNs t) const {

@@ -89,6 +89,7 @@ class Perception {
 
   void add(const hal::Imu& imu) { odometry_.add(imu); }
   void add(const hal::WheelSpeeds& wheels) { odometry_.add(wheels); }
+  void add(const hal::StateEstimate& estimate) { odometry_.add(estimate); }
   // the newest camera detections are kept for the scan of their rotation
   void add(hal::CameraDetections detections);
   // with a detector of its own: its boxes on the frame, kept as the newest

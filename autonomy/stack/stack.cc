@@ -66,6 +66,8 @@ Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<percep
 
 void Stack::take_estimate(const hal::StateEstimate& est) {
   state_ = est;
+  // the LiDAR's motion correction takes its lateral velocity
+  if (perception_) perception_->add(est);
   history_.push_back(est);
   while (!history_.empty() && est.stamp - history_.front().stamp > kNsPerSecond) history_.pop_front();
 }

@@ -39,6 +39,50 @@ TEST(OdometryTest, ConstantTurnGivesTheAnalyticArc) {
   }
 }
 
+// a sliding car: the rear axle also moves sideways at u (the estimator's vy,
+// handed in with each IMU sample as the stack does). The body-frame velocity
+// (v, u) turns with the base, so from a pose the displacement after t is
+//   x = (v sin(w t) - u (1 - cos(w t))) / w,  y = (v (1 - cos(w t)) + u sin(w t)) / w
+// (the integral of R(w s) (v, u) ds), and without u the arc is off by u t
+TEST(OdometryTest, LateralVelocityFromTheEstimateBendsTheArc) {
+  const double v = 20.0, w = 0.6, u = -1.5;
+  OdometryParams p;
+  p.lateral_velocity = true;
+  Odometry odo(p);
+  const double r = odo.params().wheel_radius;
+  for (TimeNs t = 0; t <= from_seconds(1.0); t += 5'000'000) {
+    odo.add(hal::StateEstimate{t, Pose2{}, v, u, w});
+    odo.add(hal::Imu{t, 0.0, v * w, w});
+    if (t % 10'000'000 == 0) odo.add(hal::WheelSpeeds{t, {0.0, 0.0, (v - w * 0.6) / r, (v + w * 0.6) / r}});
+  }
+  for (const auto& [a, b] : {std::pair{0.2, 0.3}, std::pair{0.5, 0.2}, std::pair{0.31, 0.3125}, std::pair{0.0, 1.0}}) {
+    const std::optional<Pose2> rel = odo.relative(from_seconds(a), from_seconds(b));
+    ASSERT_TRUE(rel.has_value()) << a << " -> " << b;
+    const double th = w * (b - a);
+    EXPECT_NEAR(rel->x, (v * std::sin(th) - u * (1.0 - std::cos(th))) / w, 1e-3) << a << " -> " << b;
+    EXPECT_NEAR(rel->y, (v * (1.0 - std::cos(th)) + u * std::sin(th)) / w, 1e-3) << a << " -> " << b;
+    EXPECT_NEAR(rel->yaw, th, 1e-6);
+  }
+  // one rotation's (0.1 s) lateral displacement is the 15 cm the correction needs
+  const std::optional<Pose2> scan = odo.relative(from_seconds(0.4), from_seconds(0.5));
+  ASSERT_TRUE(scan.has_value());
+  EXPECT_NEAR(scan->y - v / w * (1.0 - std::cos(w * 0.1)), u * 0.1, 2e-3);
+  // a non-finite estimate is refused, and counted
+  const std::size_t before = odo.rejected();
+  odo.add(hal::StateEstimate{from_seconds(1.0), Pose2{}, v, std::numeric_limits<double>::quiet_NaN(), w});
+  EXPECT_EQ(odo.rejected(), before + 1);
+  // off (the default): the estimate is not taken, the arc is the kinematic one
+  Odometry kinematic;
+  for (TimeNs t = 0; t <= from_seconds(0.5); t += 5'000'000) {
+    kinematic.add(hal::StateEstimate{t, Pose2{}, v, u, w});
+    kinematic.add(hal::Imu{t, 0.0, v * w, w});
+    if (t % 10'000'000 == 0) kinematic.add(hal::WheelSpeeds{t, {0.0, 0.0, (v - w * 0.6) / r, (v + w * 0.6) / r}});
+  }
+  const std::optional<Pose2> k = kinematic.relative(from_seconds(0.4), from_seconds(0.5));
+  ASSERT_TRUE(k.has_value());
+  EXPECT_NEAR(k->y, v / w * (1.0 - std::cos(w * 0.1)), 1e-6);
+}
+
 TEST(OdometryTest, StraightLineAndExtrapolationLimits) {
   OdometryParams p;
   p.extrapolation = 0.02;
