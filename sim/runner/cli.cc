@@ -10,7 +10,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <tuple>
-#include <charconv>
 #include <iostream>
 
 #include "autonomy/common/format.h"
@@ -198,13 +197,8 @@ int cmd_run(const std::vector<std::string>& args) {
     else if (a == "--profile") profile = true;
     else if (a == "--threads") {
       // the run on N threads: the camera beside the LiDAR, FastSLAM's particles split N ways
-      const std::string v = value("--threads");
-      int n = 0;
-      const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), n);
-      if (ec != std::errc() || end != v.data() + v.size() || n < 1 || n > Workers::kMaxThreads)
-        throw UserError("--threads: expected a whole number of threads in [1, " + std::to_string(Workers::kMaxThreads) +
-                        "], got '" + v + "'");
-      overrides.push_back("sim.threads=" + std::to_string(std::min(n, 2)));
+      const int n = option_int("--threads", value("--threads"), 1, Workers::kMaxThreads);
+      overrides.push_back("sim.threads=" + std::to_string(std::min(n, SimSection::kMaxThreads)));
       overrides.push_back("slam.threads=" + std::to_string(n));
     }
     else if (!a.empty() && a[0] == '-') throw UserError("unknown option " + a + "\n" + kUsage);

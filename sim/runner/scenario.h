@@ -97,7 +97,9 @@ struct SimSection {
   int log_rate = 100;
   double snapshot_time = 12.0;
   // 2: the camera renders (and its detector node reads the frame) on a
-  // second thread while the LiDAR casts on the loop's; the same result
+  // second thread while the LiDAR casts on the loop's; the same result. No
+  // more than kMaxThreads: nothing else of the loop runs beside them
+  static constexpr int kMaxThreads = 2;
   int threads = 1;
 
   template <class V>
@@ -106,7 +108,7 @@ struct SimSection {
     v(PADDOCK_PARAM(control_rate), {"Hz", params::in(1, 100000), "the stack's cycle (and the state estimate's rate)"});
     v(PADDOCK_PARAM(log_rate), {"Hz", params::in(1, 100000), "rows of log.csv, and the event's off-course checks"});
     v(PADDOCK_PARAM(snapshot_time), {"s", params::in(0.0, 1e6), "the first LiDAR scan after this is kept for the perception figures"});
-    v(PADDOCK_PARAM(threads), {"", params::in(1, 2), "2: the camera renders beside the LiDAR's cast, on a thread of its own (the result is the same)"});
+    v(PADDOCK_PARAM(threads), {"", params::in(1, kMaxThreads), "2: the camera renders beside the LiDAR's cast, on a thread of its own (the result is the same)"});
   }
   std::string check() const {
     return physics_rate % control_rate == 0 && physics_rate % log_rate == 0
