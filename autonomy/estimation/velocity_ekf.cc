@@ -336,7 +336,13 @@ void VelocityEkf::rear_slip_update() {
   Vector Hy = Vector::Zero();
   Hy(kVy) = 1.0;
   const double sigma = params_.vy_std + params_.vy_relative * std::abs(model);
-  update(model - x_(kVy), Hy, sigma * sigma);
+  const double nu = model - x_(kVy);
+  // past the gate the car slides: the tyres are out of the model's range
+  if (params_.vy_gate > 0.0 && nu * nu > params_.vy_gate * (P_(kVy, kVy) + sigma * sigma)) {
+    ++vy_gated_;
+    return;
+  }
+  update(nu, Hy, sigma * sigma);
 }
 
 EkfStatus VelocityEkf::on_wheel_speeds(const hal::WheelSpeeds& m) {
