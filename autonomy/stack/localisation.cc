@@ -104,6 +104,7 @@ void Localisation::on_scan(const hal::LidarScan& scan) {
 void Localisation::on_wheel_speeds(const hal::WheelSpeeds& m) {
   if (ekf_.on_wheel_speeds(m) != estimation::EkfStatus::Ok) stats_.last_fault = "wheel speeds refused (not finite or out of order)";
   stats_.rejected_messages = static_cast<long>(ekf_.rejected());
+  stats_.slide_samples = static_cast<long>(ekf_.vy_gated());
 }
 void Localisation::on_steering(const hal::SteeringAngle& m) {
   if (ekf_.on_steering(m) != estimation::EkfStatus::Ok) stats_.last_fault = "a steering angle refused (not finite or out of order)";

@@ -126,6 +126,7 @@ struct LocalisationStats {
   int relocalisations = 0;  // the filter re-anchored where the frame fit the map
   int relocalisation_failures = 0;  // searches that found no pose
   long rejected_messages = 0;  // odometry messages the EKF refused (not finite, out of order)
+  long slide_samples = 0;      // wheel updates whose lateral-slip model the EKF skipped at its gate (slides)
   // slam = lio
   long lio_scans = 0;
   long lio_degenerate_slices = 0;  // updated, but a pose direction unobserved

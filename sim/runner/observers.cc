@@ -151,6 +151,7 @@ SlamMetrics SlamScorer::metrics(const SimModel& model, const SimState& state, co
     m.lost_frames = st.lost_frames;
     m.relocalisations = st.relocalisations;
     m.rejected_messages = st.rejected_messages;
+    m.slide_samples = st.slide_samples;
     const std::vector<double>& ms = loc->lio() ? st.lio_ms : st.update_ms;
     double sum = 0.0;
     for (double x : ms) sum += x;

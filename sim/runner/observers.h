@@ -124,6 +124,7 @@ struct SlamMetrics {
   long lost_frames = 0;            // frames the front end associated too little in
   int relocalisations = 0;         // re-anchored where a frame fit the map
   long rejected_messages = 0;      // odometry messages the EKF refused
+  long slide_samples = 0;          // wheel updates the EKF judged a slide (its lateral-slip model skipped)
   double update_ms_mean = 0.0, update_ms_p99 = 0.0;  // wall time of a SLAM update (slam = lio: of a scan's LIO)
   long lio_slices = 0, lio_degenerate_slices = 0, lio_too_few_points = 0;  // slam = lio
   std::vector<SlamSample> series;  // every log sample, for the figures

@@ -189,7 +189,8 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
     if (s.autonomy.slam != stack::SlamMode::GroundTruth) {
       o << "              " << r.slam.frames << " frames, " << r.slam.fallbacks << " unusable, " << r.slam.lost_frames
         << " lost, " << r.slam.relocalisations << " relocalisations, " << r.slam.rejected_messages
-        << " refused odometry messages, " << r.slam.loop_closures << " loop closures; update "
+        << " refused odometry messages, " << r.slam.slide_samples << " slide samples, " << r.slam.loop_closures
+        << " loop closures; update "
         << fixed(r.slam.update_ms_mean, 2) << " ms mean, " << fixed(r.slam.update_ms_p99, 2) << " ms p99\n";
     }
     if (s.autonomy.slam == stack::SlamMode::Lio || s.autonomy.slam == stack::SlamMode::LioGraph) {
@@ -268,6 +269,7 @@ nlohmann::json slam_json(const Scenario& s, const SlamMetrics& m) {
           {"lost_frames", m.lost_frames},
           {"relocalisations", m.relocalisations},
           {"rejected_messages", m.rejected_messages},
+          {"slide_samples", m.slide_samples},
           {"update_ms_mean", m.update_ms_mean},
           {"update_ms_p99", m.update_ms_p99},
           {"lio_slices", m.lio_slices},

@@ -185,7 +185,8 @@ TEST(Cli, JsonSummaryCarriesTheSchema) {
   ASSERT_EQ(o.code, 0) << o.output;
   for (const char* key : {"\"scenario\":", "\"event\":\"autocross\"", "\"finished\":", "\"laps\":[", "\"penalties\":{",
                           "\"doo\":", "\"oc\":", "\"uss\":", "\"raw_time\":", "\"total_time\":", "\"sim_time\":",
-                          "\"wall_time\":", "\"realtime_factor\":", "\"tracking\":{", "\"rms\":", "\"max\":", "\"itae\":"}) {
+                          "\"wall_time\":", "\"realtime_factor\":", "\"tracking\":{", "\"rms\":", "\"max\":", "\"itae\":",
+                          "\"slide_samples\":"}) {
     EXPECT_THAT(o.output, HasSubstr(key));
   }
   EXPECT_EQ(o.output.front(), '{');
