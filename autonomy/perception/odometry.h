@@ -14,17 +14,17 @@
 // front wheels are steered and see the lever arm of the wheelbase). The
 // lateral velocity of the rear axle u is the stack's own estimate of it when
 // lateral_velocity is on and the stack hands one in (add(StateEstimate): the
-// velocity estimator's vy,
-// which the tyres' slip angles make 1-2 m/s at 20 m/s in a hard turn, 10-20 cm
-// over a rotation), and zero otherwise (no side slip there: a kinematic
-// model). The base's velocity in its own frame is then (v, u):
+// velocity estimator's vy, which the tyres' slip angles make 1-2 m/s at
+// 20 m/s in a hard turn, 10-20 cm over a rotation), and zero otherwise (no
+// side slip there: a kinematic model). The base's velocity in its own frame
+// is then (v, u):
 //   x' = v cos(yaw) - u sin(yaw), y' = v sin(yaw) + u cos(yaw).
 //
 // Each message starts a new interval: between two consecutive message stamps
-// v and w are held at their latest values (zero-order hold) and the motion
+// v, u and w are held at their latest values (zero-order hold) and the motion
 // is integrated exactly (a circular arc, a straight line when w = 0), so a
-// constant speed, lateral velocity and yaw rate give the exact arc. A pose between two knots
-// is the arc from the earlier one.
+// constant speed, lateral velocity and yaw rate give the exact arc. A pose
+// between two knots is the arc from the earlier one.
 //
 // No I/O, no clock, no global state.
 #include <cmath>
