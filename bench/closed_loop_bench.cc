@@ -32,10 +32,7 @@ void BM_DefaultScenario(benchmark::State& state) {
   if (mode == 2) overrides.push_back("autonomy.planner=oracle");
   if (mode == 3) overrides.push_back("autonomy.slam=lio");
   if (mode == 4) overrides.push_back("autonomy.slam=ground_truth");
-  if (mode == 5) {
-    overrides.push_back("sim.threads=2");
-    overrides.push_back("slam.threads=2");
-  }
+  if (mode == 5) overrides = runner::thread_overrides(2);
   const runner::Scenario sc =
       runner::load_scenario(std::string(PADDOCK_SOURCE_DIR) + "/scenarios/fsg_2023_trackdrive.ini", overrides);
   const world::TrackModel track = world::build_track(runner::load_track_file(sc.track_path));

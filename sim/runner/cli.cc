@@ -198,8 +198,7 @@ int cmd_run(const std::vector<std::string>& args) {
     else if (a == "--threads") {
       // the run on N threads: the camera beside the LiDAR, FastSLAM's particles split N ways
       const int n = option_int("--threads", value("--threads"), 1, Workers::kMaxThreads);
-      overrides.push_back("sim.threads=" + std::to_string(std::min(n, SimSection::kMaxThreads)));
-      overrides.push_back("slam.threads=" + std::to_string(n));
+      for (std::string& o : thread_overrides(n)) overrides.push_back(std::move(o));
     }
     else if (!a.empty() && a[0] == '-') throw UserError("unknown option " + a + "\n" + kUsage);
     else if (scenario_path.empty()) scenario_path = a;

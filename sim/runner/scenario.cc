@@ -272,6 +272,10 @@ std::string Scenario::check() const {
          " ms to integrate stably)";
 }
 
+std::vector<std::string> thread_overrides(int n) {
+  return {"sim.threads=" + std::to_string(std::min(n, SimSection::kMaxThreads)), "slam.threads=" + std::to_string(n)};
+}
+
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides) {
   return load_scenario_entries(read_ini_file(path), path, overrides);
 }

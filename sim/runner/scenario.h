@@ -249,6 +249,11 @@ struct Scenario {
   std::string check() const;
 };
 
+// the overrides of a run on n threads (paddock run --threads n): the camera
+// beside the LiDAR (sim.threads, at most SimSection::kMaxThreads) and
+// FastSLAM's particles split n ways (slam.threads); the same result
+std::vector<std::string> thread_overrides(int n);
+
 // reads, resolves includes, applies the overrides ("section.key=value"), checks
 // every key and value; throws UserError "file:line: ..." on any problem
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides = {});
