@@ -10,6 +10,8 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 
+#include "autonomy/common/fast_math.h"
+
 namespace paddock::slam {
 
 namespace {
@@ -51,10 +53,13 @@ Predicted predict_measurement(const Pose2& s, Vec2 m) {
   const double dx = m.x - s.x, dy = m.y - s.y;
   const double q = std::max(dx * dx + dy * dy, 1e-12);
   const double r = std::sqrt(q);
+  // one division: the Jacobians' 1/r and 1/q from it
+  const double inv_r = 1.0 / r, inv_q = inv_r * inv_r;
+  const double cx = dx * inv_r, cy = dy * inv_r, ex = dx * inv_q, ey = dy * inv_q;
   Predicted p;
-  p.z = {r, wrap(std::atan2(dy, dx) - s.yaw)};
-  p.Hm << dx / r, dy / r, -dy / q, dx / q;
-  p.Hs << -dx / r, -dy / r, 0.0, dy / q, -dx / q, -1.0;
+  p.z = {r, wrap(fast_atan2(dy, dx) - s.yaw)};
+  p.Hm << cx, cy, -ey, ex;
+  p.Hs << -cx, -cy, 0.0, ey, -ex, -1.0;
   return p;
 }
 
@@ -555,7 +560,7 @@ void FastSlam::expect_and_remove(Particle& p, Scratch& w) {
       // hidden behind an obstacle in its bearing: not expected either
       if (free_range_ != nullptr) {
         const std::vector<float>& fr = *free_range_;
-        const float edge = fr[hal::free_range_bin(std::atan2(b.y, b.x), fr.size())];
+        const float edge = fr[hal::free_range_bin(fast_atan2(b.y, b.x), fr.size())];
         if (std::sqrt(b2) > static_cast<double>(edge) + pr.occlusion_margin) continue;
       }
     }
