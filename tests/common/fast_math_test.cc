@@ -1,7 +1,7 @@
-// fast_atan and fast_atan2 against glibc's correctly rounded std::atan and
-// std::atan2: the error in units in the last place over a million random
-// arguments spread over 40 orders of magnitude and every octant, and the
-// special values (zeros of both signs, infinities, NaN) one by one.
+// fast_atan2 against glibc's correctly rounded std::atan2: the error in
+// units in the last place over a million random argument pairs, half near
+// the unit circle, half spread over 40 orders of magnitude, in every octant;
+// and the special values (zeros of both signs, infinities, NaN) one by one.
 #include "autonomy/common/fast_math.h"
 
 #include <gtest/gtest.h>
@@ -28,22 +28,9 @@ double spread(std::mt19937_64& rng) {
   return s(rng) < 0.5 ? -m : m;
 }
 
-TEST(FastMath, AtanIsWithinAboutOneUlpOfTheLibrary) {
-  std::mt19937_64 rng(1);
-  std::uniform_real_distribution<double> unit(-3.0, 3.0);
-  double worst = 0.0;
-  for (int i = 0; i < 1000000; ++i) {
-    // half near the folds (0.66, tan(3 pi/8) = 2.414), half over the whole range
-    const double x = i % 2 == 0 ? unit(rng) : spread(rng);
-    worst = std::max(worst, ulps(fast_atan(x), std::atan(x)));
-  }
-  std::printf("fast_atan: worst %.2f ulp\n", worst);
-  EXPECT_LE(worst, 1.5);
-}
-
-TEST(FastMath, Atan2IsWithinTwoUlpOfTheLibraryInEveryOctant) {
+TEST(FastMath, Atan2IsWithinOneUlpOfTheLibraryInEveryOctant) {
   std::mt19937_64 rng(2);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);  // both folds (|y/x| past 0.66 and under)
   double worst = 0.0, worst_abs = 0.0;
   for (int i = 0; i < 1000000; ++i) {
     const double y = i % 2 == 0 ? unit(rng) : spread(rng);
@@ -55,7 +42,7 @@ TEST(FastMath, Atan2IsWithinTwoUlpOfTheLibraryInEveryOctant) {
   std::printf("fast_atan2: worst %.2f ulp, %.3g rad\n", worst, worst_abs);
   // near +-pi and +-pi/2 the last place is 2.2e-16 or 4.4e-16 rad; pi's
   // own rounding adds at most 1.2e-16 rad
-  EXPECT_LE(worst, 2.5);
+  EXPECT_LE(worst, 1.5);
   EXPECT_LE(worst_abs, 5e-16);
 }
 
@@ -72,11 +59,6 @@ TEST(FastMath, SpecialValuesAreTheLibrarys) {
   EXPECT_TRUE(std::isnan(fast_atan2(nan, 1.0)));
   EXPECT_TRUE(std::isnan(fast_atan2(1.0, nan)));
   EXPECT_TRUE(std::isnan(fast_atan2(kInf, kInf)));
-  EXPECT_TRUE(std::isnan(fast_atan(nan)));
-  EXPECT_EQ(fast_atan(kInf), std::atan(kInf));
-  EXPECT_EQ(fast_atan(-kInf), std::atan(-kInf));
-  EXPECT_EQ(fast_atan(0.0), 0.0);
-  EXPECT_TRUE(std::signbit(fast_atan(-0.0)));
 }
 
 }  // namespace
