@@ -172,7 +172,8 @@ void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
   correction_ = compose(fastslam_->pose(), between(odom, Pose2{}));
   const Eigen::Matrix3d cov = fastslam_->pose_covariance();
   slam_variance_ = cov(0, 0) + cov(1, 1);
-  odom_variance_at_frame_ = odometry_variance();
+  slam_yaw_variance_ = cov(2, 2);
+  last_frame_stamp_ = d.stamp;
   const auto t1 = std::chrono::steady_clock::now();
   stats_.update_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
 }
@@ -298,7 +299,12 @@ double Localisation::position_variance() const {
     return c(0, 0) + c(1, 1);
   }
   if (!fastslam_) return odometry_variance();
-  return slam_variance_ + std::max(0.0, odometry_variance() - odom_variance_at_frame_);
+  const estimation::VelocityEstimate e = ekf_.estimate();
+  const double d2 = squared_norm(e.pose.position() - last_frame_odom_.position());
+  const double dt = std::max(0.0, to_seconds(e.stamp - last_frame_stamp_));
+  const double added = d2 * slam_yaw_variance_ + dt * dt * (e.variance[estimation::kVx] + e.variance[estimation::kVy]) +
+                       0.25 * d2 * dt * dt * e.variance[estimation::kR];
+  return slam_variance_ + added;
 }
 
 bool Localisation::take_map_news() {

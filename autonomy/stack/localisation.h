@@ -163,7 +163,14 @@ class Localisation {
   // frames and the map disagree (0: the last frame fit)
   int lost_run() const { return lost_run_; }
   // var(x) + var(y) of the estimate (m^2): the EKF's (odometry); SLAM's
-  // particle spread at the last frame plus what the odometry added since
+  // covariance at the last frame plus what the odometry's motion since
+  // added to it: over the time dt since the frame the base moved by d (the
+  // odometry's displacement), so the frame's yaw variance moves it by
+  // |d|^2 var(yaw), the velocity's error by dt^2 (var(vx) + var(vy)), and
+  // the yaw rate's (a heading error growing as dr t) by |d|^2 dt^2 var(r) / 4.
+  // Not the growth of the EKF's own absolute variance: that is the lever
+  // of its whole run's heading error (tens of metres of it by the last lap),
+  // which the frame's correction has already taken away.
   double position_variance() const;
   const slam::FastSlam* fastslam() const { return fastslam_ ? &*fastslam_ : nullptr; }
   const slam::Lio* lio() const { return lio_ ? &*lio_ : nullptr; }
@@ -204,7 +211,8 @@ class Localisation {
   Pose2 last_frame_odom_;                    // the odometry at the last processed frame
   Pose2 correction_;                         // map <- odometry
   double slam_variance_ = 0.0;               // SLAM's var(x) + var(y) at the last frame
-  double odom_variance_at_frame_ = 0.0;      // the EKF's then
+  double slam_yaw_variance_ = 0.0;           // and its var(yaw)
+  TimeNs last_frame_stamp_ = 0;              // that frame's stamp
   bool map_news_ = false;
   LocalisationStats stats_;
   // slam = fastslam_graph
