@@ -21,14 +21,21 @@
 // infinities (std::atan2: an odd multiple of pi/4). Deterministic:
 // plain double arithmetic, no library call (built with -ffp-contract=off,
 // no FMA contraction, so every machine gives the same bits).
+//
+// coarse_atan2: to within 2e-6 rad, cheaper still (Hastings' odd polynomial),
+// for what only needs a sector (the ground segmenter's 0.2 rad sectors, on
+// every return of every scan).
+#include <algorithm>
 #include <cmath>
+
+#include "autonomy/common/geometry.h"
 
 namespace paddock {
 
 namespace fast_math_detail {
 
-constexpr double kPio2 = 1.5707963267948966192;   // pi/2, rounded
-constexpr double kPio4 = 0.78539816339744830962;  // pi/4, rounded
+constexpr double kPio2 = 0.5 * kPi;   // pi/2, rounded (exactly half of kPi)
+constexpr double kPio4 = 0.25 * kPi;  // pi/4, rounded
 constexpr double kMoreBits = 6.123233995736765886130e-17;  // pi/2 - kPio2
 
 // x + x z P(z)/Q(z), z = x^2: atan(x) for |x| <= 0.66
@@ -67,6 +74,19 @@ inline double fast_atan2(double y, double x) {
     return x + y;  // a NaN
   }
   return std::signbit(y) ? -a : a;
+}
+
+// atan2(y, x) to within 2e-6 rad: Hastings' odd polynomial for atan on
+// [0, 1] folded into the octants; 0 at the origin
+inline double coarse_atan2(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double mx = std::max(ax, ay);
+  if (mx == 0.0) return 0.0;
+  const double z = std::min(ax, ay) / mx, z2 = z * z;
+  double a = z * (0.99997726 + z2 * (-0.33262347 + z2 * (0.19354346 + z2 * (-0.11643287 + z2 * (0.05265332 + z2 * -0.01172120)))));
+  if (ay > ax) a = 0.5 * kPi - a;
+  if (x < 0.0) a = kPi - a;
+  return y < 0.0 ? -a : a;
 }
 
 }  // namespace paddock

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "autonomy/common/fast_math.h"
+
 namespace paddock::perception {
 
 namespace {
@@ -68,29 +70,14 @@ void GroundSegmenter::inter_ring(Cloud& cloud, GroundStats& stats) const {
   }
 }
 
-namespace {
-// atan2 to within 2e-6 rad (Hastings' odd polynomial for atan on [-1, 1],
-// folded into the octants): the sectors are 0.2 rad wide, and this runs for
-// every return of every scan, where std::atan2 costs 4 % of a closed-loop run
-double fast_atan2(double y, double x) {
-  const double ax = std::abs(x), ay = std::abs(y);
-  const double mx = std::max(ax, ay);
-  if (mx == 0.0) return 0.0;
-  const double z = std::min(ax, ay) / mx, z2 = z * z;
-  double a = z * (0.99997726 + z2 * (-0.33262347 + z2 * (0.19354346 + z2 * (-0.11643287 + z2 * (0.05265332 + z2 * -0.01172120)))));
-  if (ay > ax) a = 0.5 * kPi - a;
-  if (x < 0.0) a = kPi - a;
-  return y < 0.0 ? -a : a;
-}
-}  // namespace
-
 std::size_t GroundSegmenter::region_of(double x, double y) const {
   const double dx = x - calib_.mount_x, dy = y - calib_.mount_y;
   const double r = std::sqrt(dx * dx + dy * dy);
   const auto ring = static_cast<std::size_t>(
       std::upper_bound(params_.region_bounds.begin(), params_.region_bounds.end(), r) -
       params_.region_bounds.begin());
-  const double u = (fast_atan2(dy, dx) + kPi) / (2.0 * kPi);  // [0, 1]
+  // (coarse: the sectors are 0.2 rad wide, and this runs for every return of every scan)
+  const double u = (coarse_atan2(dy, dx) + kPi) / (2.0 * kPi);  // [0, 1]
   const auto sectors = static_cast<std::size_t>(params_.sectors);
   const std::size_t sector =
       std::min(sectors - 1, static_cast<std::size_t>(std::max(0.0, u * static_cast<double>(sectors))));
