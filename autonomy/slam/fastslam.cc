@@ -680,15 +680,16 @@ void FastSlam::resample() {
 }
 
 void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int64_t, Vec2>>& landmarks,
-                        std::int64_t forget_from) {
+                        std::int64_t forget_from, int particles) {
   if (!finite(pose)) {
     ++rejected_;
     return;
   }
+  const int count = particles > 0 ? particles : params_.particles;
   Particle best = particles_[static_cast<std::size_t>(best_)];
   best.pose = pose;
   best.P.setZero();
-  best.weight = 1.0 / static_cast<double>(particles_.size());
+  best.weight = 1.0 / static_cast<double>(count);
   best.copy_of = -1;
   // id -> position, then one pass over the particle's alive slots
   std::vector<std::pair<std::int64_t, Vec2>> sorted = landmarks;
@@ -712,6 +713,7 @@ void FastSlam::reanchor(const Pose2& pose, const std::vector<std::pair<std::int6
     }
   }
   if (died) best.sweep();
+  particles_.resize(static_cast<std::size_t>(count));
   for (Particle& p : particles_) p = best;
   best_ = 0;
 }

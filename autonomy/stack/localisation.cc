@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace paddock::stack {
@@ -238,7 +239,10 @@ void Localisation::optimise_graph() {
     for (auto& [id, position] : map) {
       if (const std::optional<Vec2> l = graph.landmark(id)) position = *l;
     }
-    fastslam_->reanchor(nodes_.back().estimate, map);
+    // the loop closed on the optimised map: fewer particles localise in it
+    const int closed = params_.fastslam.closed_particles;
+    fastslam_->reanchor(nodes_.back().estimate, map, std::numeric_limits<std::int64_t>::max(),
+                        closed > 0 ? closed : params_.fastslam.particles);
   }
   stats_.optimise_ms.push_back(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());

@@ -536,6 +536,72 @@ TEST(FastSlam, ACopyIsIndependentOfItsOriginal) {
   EXPECT_NE(a.all_landmarks().size(), before.size());
 }
 
+// ---- re-anchoring on a back end's estimate
+
+// a loop closure's re-anchor may shrink the set (FastSlamParams::
+// closed_particles): every particle is then the re-anchored one, the filter
+// goes on localising in its map on the smaller set, and a reset (a
+// relocalisation) brings the full set back
+TEST(FastSlam, AReanchoredSetOfAnotherSizeGoesOnLocalisingAndAResetRestoresIt) {
+  const auto world = ring_world();
+  const Noise n = realistic();
+  for (std::uint64_t seed : {5, 6, 7}) {
+    // two filters alike through one loop (the whole ring mapped); then one
+    // re-anchored on its full 60, the other on 12, both at the best
+    // particle's pose, with one landmark moved by 5 cm (by id)
+    FastSlam full(params_for(n, 2, 60), seed), few(params_for(n, 2, 60), seed);
+    drive(full, world, n, seed, kLoop);
+    drive(few, world, n, seed, kLoop);
+    ASSERT_EQ(few.particle_count(), 60u);
+    ASSERT_EQ(few.map().size(), world.size());
+    const double rmse_before = map_rmse(few.map(), world);
+    const Landmark moved = few.map().front();
+    const Vec2 to = moved.mean + Vec2{0.05, 0.0};
+    full.reanchor(full.pose(), {{moved.id, to}}, std::numeric_limits<std::int64_t>::max(), 0);
+    few.reanchor(few.pose(), {{moved.id, to}}, std::numeric_limits<std::int64_t>::max(), 12);
+    EXPECT_EQ(full.particle_count(), 60u);
+    EXPECT_EQ(few.particle_count(), 12u);
+    bool found = false;
+    for (const Landmark& l : few.map()) {
+      if (l.id != moved.id) continue;
+      found = true;
+      EXPECT_EQ(l.mean, to);
+    }
+    EXPECT_TRUE(found);
+    // a second loop, the same odometry and observations for both: the 12
+    // localise in the map they have as well as the 60 do, and keep it
+    std::mt19937_64 rng(seed + 50);
+    double err_full = 0.0, err_few = 0.0;
+    for (int k = kLoop + 1; k <= 2 * kLoop; ++k) {
+      const Pose2 a = true_pose((k - 1) * kStep), b = true_pose(k * kStep);
+      const Pose2 d = noisy_delta(delta_of(a, b), n, rng);
+      const std::vector<Observation> obs = observe(world, b, n, rng);
+      full.predict(d);
+      full.update(obs);
+      few.predict(d);
+      few.update(obs);
+      ASSERT_EQ(few.particle_count(), 12u);
+      err_full = std::max(err_full, pose_error(full.pose(), b));
+      err_few = std::max(err_few, pose_error(few.pose(), b));
+    }
+    const double rmse_full = map_rmse(full.map(), world), rmse_few = map_rmse(few.map(), world);
+    std::printf("seed %d: map RMSE %.4f m after the first loop; after the second on 60 / 12 particles: %.4f / %.4f m, "
+                "pose error max %.3f / %.3f m\n",
+                static_cast<int>(seed), rmse_before, rmse_full, rmse_few, err_full, err_few);
+    EXPECT_EQ(few.map().size(), world.size());
+    EXPECT_LT(rmse_few, rmse_before + 0.02);
+    EXPECT_LT(rmse_few, rmse_full + 0.02);
+    EXPECT_LT(err_few, err_full + 0.1);
+    EXPECT_LE(few.effective_particles(), 12.0 + 1e-9);
+    // a relocalisation's re-anchor and a reset: the full set again
+    few.reanchor(few.pose(), {}, few.updates());
+    EXPECT_EQ(few.particle_count(), 60u);
+    few.reanchor(few.pose(), {}, std::numeric_limits<std::int64_t>::max(), 12);
+    few.reset(true_pose(0.0));
+    EXPECT_EQ(few.particle_count(), 60u);
+  }
+}
+
 // ---- colour votes
 
 TEST(FastSlam, ACameraVoteOutweighsALidarVote) {
