@@ -36,6 +36,20 @@ bool sane(const Pose2& p) { return sane(p.x) && sane(p.y) && sane(p.yaw); }
 // node, the same 11 iterations each), 5100 nodes: Eigen 1.03 s, SuiteSparse
 // 1.13 s, SPARSE_SCHUR 1.64 s, CXSparse 0.96 s (deprecated, gone in Ceres
 // 2.2); 1500 nodes: Eigen 264 ms, SuiteSparse 320 ms, SPARSE_SCHUR 341 ms.
+// the step test of PoseGraphParams::step_tolerance: after a successful
+// step shorter than it, the solve ends (Ceres reports USER_SUCCESS)
+class StepTest : public ceres::IterationCallback {
+ public:
+  explicit StepTest(double tolerance) : tolerance_(tolerance) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    const bool short_step = s.iteration > 0 && s.step_is_successful && s.step_norm < tolerance_;
+    return short_step ? ceres::SOLVER_TERMINATE_SUCCESSFULLY : ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  double tolerance_;
+};
+
 ceres::Solver::Options solver_options(int max_iterations) {
   ceres::Solver::Options o;
   o.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
@@ -185,13 +199,18 @@ PoseGraph::Result PoseGraph::optimise() {
   const std::vector<std::array<double, 3>> poses_before = poses_;
   const std::vector<std::array<double, 2>> landmarks_before = landmarks_;
   ceres::Solver::Summary summary;
-  ceres::Solve(solver_options(params_.max_iterations), &problem, &summary);
+  ceres::Solver::Options options = solver_options(params_.max_iterations);
+  StepTest step_test(params_.step_tolerance);
+  if (params_.step_tolerance > 0.0) options.callbacks.push_back(&step_test);
+  ceres::Solve(options, &problem, &summary);
 
   res.ok = summary.IsSolutionUsable();
   res.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
   res.initial_cost = summary.initial_cost;
   res.final_cost = summary.final_cost;
-  if (summary.termination_type != ceres::CONVERGENCE) res.reason = summary.message;
+  if (summary.termination_type != ceres::CONVERGENCE && summary.termination_type != ceres::USER_SUCCESS) {
+    res.reason = summary.message;
+  }
   if (!res.ok) {
     poses_ = poses_before;
     landmarks_ = landmarks_before;

@@ -328,6 +328,41 @@ TEST(PoseGraph, PullsAKnownDriftedLoopBackToWithinFiveCentimetres) {
   }
 }
 
+// the step test (PoseGraphParams::step_tolerance) ends the solve early, and
+// within its tolerance of where the solve run to Ceres' own tests ends: the
+// drifted loop with FastSlamParams' realistic noise model and observations
+// twice as noisy as it says (as the raw perception's centroids are: a part
+// of the residuals then sits in Huber's linear range, and LM closes in
+// linearly there, as on the default run's windows)
+TEST(PoseGraph, TheStepTestEndsWithinItsToleranceOfTheFullSolve) {
+  const Drive d = drifted_drive(12.0);
+  for (std::uint64_t seed : {7u, 8u}) {
+    PoseGraphParams quick = loop_params();
+    quick.range_std = 0.02;
+    quick.range_std_per_m = 0.01;
+    quick.bearing_std = 0.2 * kPi / 180.0;
+    PoseGraphParams full = quick;
+    full.step_tolerance = 0.0;
+    const SensorNoise noise{2.0 * quick.range_std, 2.0 * quick.range_std_per_m, 2.0 * quick.bearing_std};
+    PoseGraph a = graph_of(d, quick, noise, seed), b = graph_of(d, full, noise, seed);
+    const PoseGraph::Result ra = a.optimise(), rb = b.optimise();
+    ASSERT_TRUE(ra.ok) << ra.reason;
+    ASSERT_TRUE(rb.ok) << rb.reason;
+    EXPECT_EQ(ra.reason, "");
+    double worst = 0.0;
+    for (int i = 0; i < a.nodes(); ++i) {
+      worst = std::max({worst, distance(a.pose(i).position(), b.pose(i).position()),
+                        std::abs(wrap_angle(a.pose(i).yaw - b.pose(i).yaw))});
+    }
+    for (const Cone& c : d.cones) worst = std::max(worst, distance(*a.landmark(c.id), *b.landmark(c.id)));
+    std::printf("seed %d: %d iterations with the step test, %d without; %.2g apart at most\n", static_cast<int>(seed),
+                ra.iterations, rb.iterations, worst);
+    EXPECT_LT(ra.iterations, rb.iterations);
+    EXPECT_LT(worst, quick.step_tolerance);
+    EXPECT_LE(ra.final_cost, ra.initial_cost);
+  }
+}
+
 // ---- 4. Ceres' solution against a dense Gauss-Newton written here
 
 // a small noisy problem: 5 poses 1.5 m apart on a 10 m arc, 4 cones each
@@ -429,6 +464,7 @@ TEST(PoseGraph, CeresSolutionEqualsADenseGaussNewton) {
   const Small s = small_problem();
   PoseGraphParams p;
   p.huber_scale = 0.0;  // plain least squares: the objective Gauss-Newton minimises
+  p.step_tolerance = 0.0;  // to the end, as the reference goes (the step test: below)
   PoseGraph g(p);
   Eigen::VectorXd x0(20);
   for (int i = 0; i < 5; ++i) {
