@@ -36,8 +36,135 @@ constexpr double kCarryStep = 1e-4;     // m, past a hit before casting on
 constexpr int kMaxCarry = 64;           // surfaces a carried-on ray may pass
 constexpr std::uint8_t kMaxCover = 255;
 constexpr int kGroundTile = 4;          // px, non-flat ground outside the boxes
+// r0 + (r1 - r0) a / length at a vertex's a may round a little below its
+// distance from the axis even where the vertex defines r0 or r1
+constexpr double kFrustumTolerance = 1e-9;  // m
+
+// the rays from one origin against one frustum: the terms that depend only
+// on the two, then one ray at a time (ray_meets_frustum)
+class FrustumRays {
+ public:
+  FrustumRays(const ConeFrustum& f, const double o[3])
+      : ax_(f.axis), p_((f.axis + 1) % 3), q_((f.axis + 2) % 3), length_(f.length) {
+    // the ray in the frustum's terms: a(t) = alpha + beta t along the axis,
+    // (ep + t fp, eq + t fq) across it; the radius there r0 + k a(t) =
+    // rho + k beta t
+    degenerate_ = !(f.length > 0.0);
+    k_ = degenerate_ ? 0.0 : (f.r1 - f.r0) / f.length;
+    alpha_ = o[ax_] - f.centre[ax_];
+    ep_ = o[p_] - f.centre[p_];
+    eq_ = o[q_] - f.centre[q_];
+    rho_ = f.r0 + k_ * alpha_;
+  }
+
+  bool meets(const double d[3]) const {
+    if (degenerate_) return true;  // no slope to take: say it may meet
+    const double beta = d[ax_], fp = d[p_], fq = d[q_];
+    // the t >= 0 with 0 <= a(t) <= length: [t0, t1]
+    double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
+    if (beta != 0.0) {
+      const double ta = -alpha_ / beta, tb = (length_ - alpha_) / beta;
+      t0 = std::max(t0, std::min(ta, tb));
+      t1 = std::max(ta, tb);
+      if (!(t0 <= t1)) return false;
+    } else if (!(alpha_ >= 0.0 && alpha_ <= length_)) {
+      return false;
+    }
+    // over [t0, t1] the radius is >= 0, so the ray is inside where
+    // g(t) = |across(t)|^2 - radius(t)^2 <= 0; g is a quadratic
+    // A t^2 + 2 B t + C, least over the interval at an end or, when A > 0,
+    // at -B / A
+    const double kb = k_ * beta;
+    const auto g = [&](double t) {
+      const double x = ep_ + t * fp, y = eq_ + t * fq, r = rho_ + kb * t;
+      return x * x + y * y - r * r;
+    };
+    if (g(t0) <= 0.0) return true;
+    if (t1 < std::numeric_limits<double>::infinity() && g(t1) <= 0.0) return true;
+    const double A = fp * fp + fq * fq - kb * kb;
+    if (!(A > 0.0)) return false;  // concave or linear: least at an end
+    const double tv = -(ep_ * fp + eq_ * fq - rho_ * kb) / A;
+    return tv > t0 && tv < t1 && g(tv) <= 0.0;
+  }
+
+ private:
+  int ax_, p_, q_;
+  double length_;
+  bool degenerate_ = false;
+  double k_ = 0.0, alpha_ = 0.0, ep_ = 0.0, eq_ = 0.0, rho_ = 0.0;
+};
+
 
 }  // namespace
+
+bool ray_meets_frustum(const ConeFrustum& f, const double o[3], const double d[3]) {
+  return FrustumRays(f, o).meets(d);
+}
+
+bool bounding_frustum(const float* v, const unsigned* idx, unsigned prim0, unsigned prim1, int axis, double margin,
+                      ConeFrustum& f) {
+  if (prim1 <= prim0) return false;
+  // the vertices numbered from the triangles' least index to their greatest:
+  // theirs and maybe others, which could only make the frustum larger (a
+  // LidarWorld cone's 33 vertices are numbered together, and its 48
+  // triangles name each about 4 times)
+  unsigned first = idx[3 * prim0], last = first;
+  for (unsigned k = 3 * prim0; k < 3 * prim1; ++k) {
+    first = std::min(first, idx[k]);
+    last = std::max(last, idx[k]);
+  }
+  const float* const begin = v + 3 * static_cast<std::size_t>(first);
+  const float* const end = v + 3 * (static_cast<std::size_t>(last) + 1);
+  const int p = (axis + 1) % 3, q = (axis + 2) % 3;
+  // their box
+  double lo[3], hi[3];
+  for (int e = 0; e < 3; ++e) lo[e] = hi[e] = begin[e];
+  for (const float* x = begin; x != end; x += 3) {
+    for (int e = 0; e < 3; ++e) {
+      if (!std::isfinite(x[e])) return false;
+      lo[e] = std::min(lo[e], static_cast<double>(x[e]));
+      hi[e] = std::max(hi[e], static_cast<double>(x[e]));
+    }
+  }
+  const double cp = 0.5 * (lo[p] + hi[p]), cq = 0.5 * (lo[q] + hi[q]), length = hi[axis] - lo[axis];
+  // squared distances from the axis (float coordinates, double arithmetic:
+  // no rounding that matters)
+  const auto radial2 = [&](const float* x) {
+    const double dp = x[p] - cp, dq = x[q] - cq;
+    return dp * dp + dq * dq;
+  };
+  // the radii at the ends: the farthest vertex of each half
+  double r0 = 0.0, r1 = 0.0;
+  for (const float* x = begin; x != end; x += 3) {
+    double& r = x[axis] - lo[axis] <= 0.5 * length ? r0 : r1;
+    r = std::max(r, radial2(x));
+  }
+  r0 = std::sqrt(r0);
+  r1 = std::sqrt(r1);
+  // verified: every vertex within the radius at its height; else the cylinder
+  bool holds = length > 0.0;
+  for (const float* x = begin; x != end && holds; x += 3) {
+    const double r = r0 + (r1 - r0) * ((x[axis] - lo[axis]) / length) + kFrustumTolerance;
+    holds = radial2(x) <= r * r;
+  }
+  if (!holds) r0 = r1 = std::max(r0, r1);
+  // grown by margin: each end moved out by margin along the axis, the radius
+  // r(a) (carried on linearly past the ends) by margin (1 + |slope|). That
+  // holds every point within margin of the frustum: its lateral surface moved
+  // out by margin along its normal is margin sqrt(1 + slope^2) further from
+  // the axis, and at the narrow end, moved margin out, the radius still
+  // exceeds the rim's by margin
+  const double slope = length > 0.0 ? (r1 - r0) / length : 0.0;
+  const double grow = margin * (1.0 + std::abs(slope));
+  f.axis = axis;
+  f.centre[axis] = lo[axis] - margin;
+  f.centre[p] = cp;
+  f.centre[q] = cq;
+  f.length = length + 2.0 * margin;
+  f.r0 = r0 - slope * margin + grow;
+  f.r1 = r1 + slope * margin + grow;
+  return true;
+}
 
 int trigger_column(const LidarParams& lidar, double azimuth) {
   const int n = std::max(lidar.columns, 1);

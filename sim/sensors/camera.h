@@ -203,6 +203,39 @@ TimeNs trigger_time(const LidarParams& lidar, double azimuth, TimeNs scan_start)
 // (what Camera::calibration() returns)
 perception::CameraCalibration camera_calibration(const CameraParams& p);
 
+// a solid truncated circular cone (frustum) about a world axis, the bound
+// Camera::render tests a pixel's ray against before casting it: the points
+// whose coordinate along `axis` (0 = world x, 2 = world z) lies in
+// [centre[axis], centre[axis] + length] and whose distance from the axis line
+// through centre is at most r0 + (r1 - r0) a / length, a the coordinate less
+// centre[axis] (r0 at the base end, r1 at the other)
+struct ConeFrustum {
+  int axis = 2;
+  double centre[3] = {0.0, 0.0, 0.0};  // m, the base end's centre
+  double length = 0.0;                 // m, > 0
+  double r0 = 0.0, r1 = 0.0;           // m, >= 0
+};
+
+// whether the ray o + t d, t >= 0, meets f (a point of it lies in f); d need
+// not be a unit vector. Exact but for double rounding (far below a micron
+// at a camera's ranges); true when f.length is not > 0
+bool ray_meets_frustum(const ConeFrustum& f, const double o[3], const double d[3]);
+
+// a frustum about world axis `axis` (0 or 2) holding every vertex of the
+// triangles prim0 .. prim1 - 1 of an Embree triangle mesh (v: its vertex
+// buffer, 3 floats a vertex; idx: its index buffer, 3 a triangle), hence the
+// triangles, grown by `margin` (m) so it also holds every point within
+// `margin` of them. The vertices taken are those numbered from the
+// triangles' least index to their greatest (theirs, and any between). Its
+// axis passes through the middle of their box across `axis`; its ends are
+// the box's along it; r0 and r1 are the largest distances from the axis of
+// the vertices in the base and the top half, kept only if then every vertex
+// lies within r0 + (r1 - r0) a / length (else a cylinder: r0 = r1 = the
+// largest distance). False, and f untouched, when a vertex is not finite or
+// there is no triangle.
+bool bounding_frustum(const float* v, const unsigned* idx, unsigned prim0, unsigned prim1, int axis, double margin,
+                      ConeFrustum& f);
+
 class Camera {
  public:
   // throws std::invalid_argument when params::validate(params) fails. The seed starts

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <string>
 #include <stdexcept>
@@ -432,6 +433,263 @@ TEST(Camera, ReusedBuffersGiveTheFramesFreshOnesGive) {
     }
     EXPECT_GE(labelled_frames, 10) << "bump " << bump;  // cones in (nearly) every frame
   }
+}
+
+// how far x lies outside f, in the units of bounding_frustum's margin: <= 0
+// inside, <= delta within f grown by delta (its ends moved out by delta, its
+// radius grown by delta (1 + |slope|)), which holds every point within delta
+// of f (a point delta from one of f is at most delta further along the axis
+// or from it, and the radius changes by at most |slope| delta between them)
+double outside(const ConeFrustum& f, const double x[3]) {
+  const int ax = f.axis, p = (ax + 1) % 3, q = (ax + 2) % 3;
+  const double a = x[ax] - f.centre[ax];
+  const double slope = (f.r1 - f.r0) / f.length;
+  const double r = f.r0 + slope * std::clamp(a, 0.0, f.length);
+  const double radial = std::hypot(x[p] - f.centre[p], x[q] - f.centre[q]);
+  return std::max({-a, a - f.length, (radial - r) / (1.0 + std::abs(slope))});
+}
+
+// ray_meets_frustum against dense sampling: random frustums (both axes,
+// narrowing, widening, cylinders, to a point) and rays from inside, near and
+// far, aimed anywhere, at the frustum, across its axis or along it. Each ray
+// is sampled every 0.1 mm where it lies within the frustum's bounding ball.
+// A ray reported as missing has no sample inside; one reported as meeting
+// has a sample within half a step of it.
+TEST(Camera, RayFrustumTestAgreesWithDenseSamplingAlongTheRay) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const auto unit = [&](double d[3]) {
+    double n = 0.0;
+    do {
+      for (int e = 0; e < 3; ++e) d[e] = 2.0 * u(rng) - 1.0;
+      n = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    } while (n > 1.0 || n < 1e-3);
+    for (int e = 0; e < 3; ++e) d[e] /= n;
+  };
+  const double h = 1e-4;  // m, the sampling step along the ray
+  int met = 0, missed = 0, near_misses = 0, inside = 0, from_inside = 0;
+  for (int n = 0; n < 10000; ++n) {
+    ConeFrustum f;
+    f.axis = n % 2 == 0 ? 2 : 0;
+    for (double& c : f.centre) c = 200.0 * u(rng) - 100.0;
+    f.length = 0.05 + 0.6 * u(rng);
+    f.r0 = 0.3 * u(rng);
+    switch (n % 8) {
+      case 0: f.r1 = f.r0; break;  // a cylinder
+      case 1: f.r1 = 0.0; break;   // to a point
+      default: f.r1 = 0.3 * u(rng);
+    }
+    const int ax = f.axis, p = (ax + 1) % 3, q = (ax + 2) % 3;
+    // a point inside: along the axis, then across within the radius there
+    const auto point_inside = [&](double x[3]) {
+      const double a = f.length * u(rng), r = (f.r0 + (f.r1 - f.r0) * a / f.length) * std::sqrt(u(rng));
+      const double phi = 2.0 * kPi * u(rng);
+      x[ax] = f.centre[ax] + a;
+      x[p] = f.centre[p] + r * std::cos(phi);
+      x[q] = f.centre[q] + r * std::sin(phi);
+    };
+    double o[3], d[3];
+    if (n % 5 == 0) {
+      ++inside;
+      point_inside(o);
+    } else {
+      double w[3];
+      unit(w);
+      const double dist = n % 5 == 1 ? 10.0 + 30.0 * u(rng) : 0.01 + 2.0 * u(rng);
+      for (int e = 0; e < 3; ++e) o[e] = f.centre[e] + 0.5 * f.length * (e == ax) + dist * w[e];
+    }
+    switch (n % 6) {
+      case 0:
+      case 1: unit(d); break;
+      case 2:
+      case 3: {  // grazing: along the surface, up to 2 mm off it, tilted a little
+        double x[3], nrm[3] = {0.0, 0.0, 0.0}, w[3];
+        if (u(rng) < 0.3) {  // an end
+          point_inside(x);
+          const bool top = u(rng) < 0.5;
+          x[ax] = f.centre[ax] + (top ? f.length : 0.0);
+          nrm[ax] = top ? 1.0 : -1.0;
+        } else {  // the side
+          const double k = (f.r1 - f.r0) / f.length, c = 1.0 / std::sqrt(1.0 + k * k);
+          const double a = f.length * u(rng), r = f.r0 + k * a, phi = 2.0 * kPi * u(rng);
+          x[ax] = f.centre[ax] + a;
+          x[p] = f.centre[p] + r * std::cos(phi);
+          x[q] = f.centre[q] + r * std::sin(phi);
+          nrm[ax] = -k * c;
+          nrm[p] = std::cos(phi) * c;
+          nrm[q] = std::sin(phi) * c;
+        }
+        unit(w);
+        const double wn = w[0] * nrm[0] + w[1] * nrm[1] + w[2] * nrm[2];
+        const double off = 0.004 * u(rng) - 0.002, tilt = 0.02 * u(rng) - 0.01, back = 0.01 + 20.0 * u(rng);
+        for (int k = 0; k < 3; ++k) {
+          d[k] = w[k] - wn * nrm[k] + tilt * nrm[k];
+          if (n % 5 != 0) o[k] = x[k] + off * nrm[k] - back * d[k];
+        }
+        break;
+      }
+      case 4: unit(d); d[ax] = 0.0; break;  // across the axis
+      default:                            // along it
+        d[0] = d[1] = d[2] = 0.0;
+        d[ax] = u(rng) < 0.5 ? 1.0 : -1.0;
+    }
+    const double scale = 0.5 + 1.5 * u(rng);  // not a unit vector
+    for (double& e : d) e *= scale;
+    const bool meets = ray_meets_frustum(f, o, d);
+    // the t where the ray lies in the ball about the axis's middle that holds f
+    const double dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    double e[3];
+    for (int k = 0; k < 3; ++k) e[k] = o[k] - (f.centre[k] + 0.5 * f.length * (k == ax));
+    const double R = 0.5 * f.length + std::max(f.r0, f.r1) + 1e-6;
+    const double b = e[0] * d[0] + e[1] * d[1] + e[2] * d[2];
+    const double disc = b * b - dd * (e[0] * e[0] + e[1] * e[1] + e[2] * e[2] - R * R);
+    double least = std::numeric_limits<double>::infinity();  // of outside()
+    if (disc >= 0.0) {
+      const double ta = std::max(0.0, (-b - std::sqrt(disc)) / dd), tb = (-b + std::sqrt(disc)) / dd;
+      const double step = h / std::sqrt(dd);
+      for (double t = ta; t <= tb + step; t += step) {
+        const double tt = std::min(t, tb);
+        if (tt < 0.0) continue;
+        const double x[3] = {o[0] + tt * d[0], o[1] + tt * d[1], o[2] + tt * d[2]};
+        least = std::min(least, outside(f, x));
+      }
+    }
+    if (meets) {
+      ++met;
+      from_inside += n % 5 == 0;
+      EXPECT_LE(least, 0.5 * h + 1e-9) << "ray " << n << " reported as meeting the frustum";
+    } else {
+      ++missed;
+      near_misses += least < 0.01;
+      EXPECT_GT(least, 0.0) << "ray " << n << " reported as missing the frustum";
+    }
+  }
+  std::printf("frustum test: %d rays meet (%d from inside), %d miss (%d within 1 cm)\n", met, from_inside, missed,
+              near_misses);
+  EXPECT_EQ(from_inside, inside);
+  EXPECT_GT(met, 3000);
+  EXPECT_GT(missed, 3000);
+  EXPECT_GT(near_misses, 500);
+}
+
+// bounding_frustum on the cone meshes LidarWorld builds (standing and
+// knocked, small and big): the frustum of the true shape (base radius, top
+// radius kConeApexRadius, height along the axis), holding every vertex and,
+// grown by a margin, every point within it of the triangles; and the
+// cylinder where the radii at the ends do not hold the middle
+TEST(Camera, BoundingFrustumOfTheConeMeshes) {
+  const std::vector<Cone> cones = {{{6.0, 2.0}, ConeColor::Blue},
+                                   {{-3.5, 41.0}, ConeColor::BigOrange},
+                                   {{60.0, -7.25}, ConeColor::Yellow},
+                                   {{12.0, 1.0}, ConeColor::BigOrange}};
+  const std::vector<bool> knocked = {false, false, true, true};
+  LidarWorld world(cones, knocked);
+  unsigned g = 0;
+  while (g < 4 && world.cone_of(g, 0) < 0) ++g;
+  ASSERT_LT(g, 4u);
+  RTCGeometry geom = rtcGetGeometry(world.scene(), g);
+  const auto* v = static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
+  const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  unsigned prim = 0;
+  for (std::size_t i = 0; i < cones.size(); ++i) {
+    const unsigned prim0 = prim;
+    while (world.cone_of(g, prim) == static_cast<std::int32_t>(i)) ++prim;
+    ASSERT_EQ(prim - prim0, 3u * kConeSegments) << i;
+    const bool big = cones[i].color == ConeColor::BigOrange;
+    const double r_base = 0.5 * (big ? kBigConeBaseWidth : kSmallConeBaseWidth);
+    const double height = big ? kBigConeHeight : kSmallConeHeight;
+    const int axis = knocked[i] ? 0 : 2;
+    ConeFrustum f;
+    ASSERT_TRUE(bounding_frustum(v, idx, prim0, prim, axis, 0.0, f));
+    EXPECT_EQ(f.axis, axis);
+    EXPECT_NEAR(f.length, height, 1e-5) << i;
+    EXPECT_NEAR(f.r0, r_base, 1e-5) << i;
+    EXPECT_NEAR(f.r1, kConeApexRadius, 1e-5) << i;
+    // the base centre: on the ground (standing), h / 2 behind the position at
+    // the base radius's height (knocked)
+    const double base[3] = {cones[i].position.x - (knocked[i] ? 0.5 * height : 0.0), cones[i].position.y,
+                            knocked[i] ? r_base : 0.0};
+    for (int e = 0; e < 3; ++e) EXPECT_NEAR(f.centre[e], base[e], 1e-5) << i << " " << e;
+    for (unsigned t = prim0; t < prim; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const float* x = v + 3 * idx[3 * t + static_cast<unsigned>(k)];
+        const double xd[3] = {x[0], x[1], x[2]};
+        EXPECT_LE(outside(f, xd), 1e-9) << i;
+      }
+    }
+    // grown by 1 mm: points up to 0.999 mm from points of the triangles
+    const double margin = 1e-3;
+    ConeFrustum grown;
+    ASSERT_TRUE(bounding_frustum(v, idx, prim0, prim, axis, margin, grown));
+    for (int n = 0; n < 20000; ++n) {
+      const unsigned t = prim0 + static_cast<unsigned>(n) % (prim - prim0);
+      double a = u(rng), b = u(rng);
+      if (a + b > 1.0) {
+        a = 1.0 - a;
+        b = 1.0 - b;
+      }
+      const float* x0 = v + 3 * idx[3 * t];
+      const float* x1 = v + 3 * idx[3 * t + 1];
+      const float* x2 = v + 3 * idx[3 * t + 2];
+      double w[3];
+      double wn = 0.0;
+      for (int e = 0; e < 3; ++e) {
+        w[e] = 2.0 * u(rng) - 1.0;
+        wn += w[e] * w[e];
+      }
+      const double s = 0.999 * margin * u(rng) / std::sqrt(wn);
+      double x[3];
+      for (int e = 0; e < 3; ++e) x[e] = x0[e] + a * (x1[e] - x0[e]) + b * (x2[e] - x0[e]) + s * w[e];
+      EXPECT_LE(outside(grown, x), 0.0) << i << " " << n;
+    }
+  }
+
+  // hand-made meshes about z: rings of 8 vertices joined by triangles
+  const auto rings = [](const std::vector<std::pair<double, double>>& za_r, std::vector<float>& vs,
+                        std::vector<unsigned>& is) {
+    vs.clear();
+    is.clear();
+    for (const auto& [z, r] : za_r) {
+      for (int s = 0; s < 8; ++s) {
+        vs.push_back(static_cast<float>(5.0 + r * std::cos(kPi * s / 4)));
+        vs.push_back(static_cast<float>(-2.0 + r * std::sin(kPi * s / 4)));
+        vs.push_back(static_cast<float>(z));
+      }
+    }
+    for (unsigned ring = 0; ring + 1 < za_r.size(); ++ring) {
+      for (unsigned s = 0; s < 8; ++s) {
+        const unsigned a = 8 * ring + s, b = 8 * ring + (s + 1) % 8;
+        for (unsigned k : {a, b, b + 8, a, b + 8, a + 8}) is.push_back(k);
+      }
+    }
+  };
+  std::vector<float> vs;
+  std::vector<unsigned> is;
+  // widening: kept as it is
+  rings({{0.0, 0.05}, {1.0, 0.2}}, vs, is);
+  ConeFrustum f;
+  ASSERT_TRUE(bounding_frustum(vs.data(), is.data(), 0, static_cast<unsigned>(is.size() / 3), 2, 0.0, f));
+  EXPECT_NEAR(f.r0, 0.05, 1e-6);
+  EXPECT_NEAR(f.r1, 0.2, 1e-6);
+  EXPECT_NEAR(f.centre[0], 5.0, 1e-6);
+  EXPECT_NEAR(f.centre[1], -2.0, 1e-6);
+  // a barrel: the middle ring sticks out of the ends' frustum, so the
+  // cylinder of the widest ring
+  rings({{0.0, 0.05}, {0.5, 0.2}, {1.0, 0.05}}, vs, is);
+  ASSERT_TRUE(bounding_frustum(vs.data(), is.data(), 0, static_cast<unsigned>(is.size() / 3), 2, 0.0, f));
+  EXPECT_NEAR(f.r0, 0.2, 1e-6);
+  EXPECT_NEAR(f.r1, 0.2, 1e-6);
+  EXPECT_NEAR(f.length, 1.0, 1e-6);
+  for (std::size_t k = 0; k < vs.size(); k += 3) {
+    const double x[3] = {vs[k], vs[k + 1], vs[k + 2]};
+    EXPECT_LE(outside(f, x), 1e-9);
+  }
+  // no triangle, or a vertex not finite: none
+  EXPECT_FALSE(bounding_frustum(vs.data(), is.data(), 3, 3, 2, 0.0, f));
+  vs[4] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(bounding_frustum(vs.data(), is.data(), 0, static_cast<unsigned>(is.size() / 3), 2, 0.0, f));
 }
 
 TEST(Camera, TriggerIsTheLidarColumnAtTheAzimuth) {
