@@ -36,6 +36,13 @@ constexpr double kCarryStep = 1e-4;     // m, past a hit before casting on
 constexpr int kMaxCarry = 64;           // surfaces a carried-on ray may pass
 constexpr std::uint8_t kMaxCover = 255;
 constexpr int kGroundTile = 4;          // px, non-flat ground outside the boxes
+// the cones' bounding frustums are grown by 1 mm plus 64 float epsilons of
+// the scene's scale (the coordinates' magnitudes): far more than Embree's
+// float arithmetic can put a hit outside its triangle, or the frustum test's
+// rays (the pixel's direction before it is normalised and rounded to float)
+// can differ from the rays cast
+constexpr double kFrustumMargin = 1e-3;  // m
+constexpr double kFrustumRelMargin = 64.0 * std::numeric_limits<float>::epsilon();
 // r0 + (r1 - r0) a / length at a vertex's a may round a little below its
 // distance from the axis even where the vertex defines r0 or r1
 constexpr double kFrustumTolerance = 1e-9;  // m
@@ -93,7 +100,6 @@ class FrustumRays {
   bool degenerate_ = false;
   double k_ = 0.0, alpha_ = 0.0, ep_ = 0.0, eq_ = 0.0, rho_ = 0.0;
 };
-
 
 }  // namespace
 
@@ -251,6 +257,8 @@ std::array<std::uint8_t, 3> Camera::shade(const Rgb& a, double lambert) const {
 void Camera::read_cones(const LidarWorld& world) {
   cones_.clear();
   cone_geom_id_ = RTC_INVALID_GEOMETRY_ID;
+  cone_v_ = nullptr;
+  cone_idx_ = nullptr;
   geom_of_.assign(world.cone_count(), -1);
   // the cone geometry: the one whose primitive 0 belongs to a cone (LidarWorld
   // attaches the ground, then the cones)
@@ -266,7 +274,10 @@ void Camera::read_cones(const LidarWorld& world) {
   const auto* v = static_cast<const float*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_VERTEX, 0));
   const auto* idx = static_cast<const unsigned*>(rtcGetGeometryBufferData(geom, RTC_BUFFER_TYPE_INDEX, 0));
   if (v == nullptr || idx == nullptr) return;
-  // every triangle grows the box of its cone; a cone's triangles are contiguous
+  cone_v_ = v;
+  cone_idx_ = idx;
+  // every triangle grows the box of its cone; a cone's triangles are
+  // contiguous (lidar.cc; one that is not gets no frustum)
   std::int32_t prev = -1;
   ConeGeom* cur = nullptr;
   for (unsigned prim = 0;; ++prim) {
@@ -283,10 +294,13 @@ void Camera::read_cones(const LidarWorld& world) {
         std::copy(p, p + 3, cg.lo);
         std::copy(p, p + 3, cg.hi);
         cones_.push_back(cg);
+      } else {
+        cones_[static_cast<std::size_t>(geom_of_[cu])].split = true;
       }
       cur = &cones_[static_cast<std::size_t>(geom_of_[cu])];
       prev = c;
     }
+    cur->prim_end = prim + 1;
     for (int k = 0; k < 3; ++k) {
       const float* p = v + 3 * idx[3 * prim + static_cast<unsigned>(k)];
       for (int a = 0; a < 3; ++a) {
@@ -297,12 +311,16 @@ void Camera::read_cones(const LidarWorld& world) {
   }
 }
 
-ConeColor Camera::cone_class(const LidarWorld& world, const ConeGeom& c, double mid[3]) const {
+bool Camera::is_standing(const ConeGeom& c) {
   // lidar.h: a standing cone's axis is world +z from its base centre, a knocked
   // cone's world +x (base at -x); standing cones are taller than wide, knocked
   // ones longer along x than high
+  return c.hi[2] - c.lo[2] > c.hi[0] - c.lo[0];
+}
+
+ConeColor Camera::cone_class(const LidarWorld& world, const ConeGeom& c, double mid[3]) const {
   const double ex = c.hi[0] - c.lo[0], ez = c.hi[2] - c.lo[2];
-  const bool standing = ez > ex;
+  const bool standing = is_standing(c);
   const double base[3] = {standing ? 0.5 * (c.lo[0] + c.hi[0]) : c.lo[0], 0.5 * (c.lo[1] + c.hi[1]),
                           standing ? c.lo[2] : 0.5 * (c.lo[2] + c.hi[2])};
   const double axis[3] = {standing ? 0.0 : 1.0, 0.0, standing ? 1.0 : 0.0};
@@ -379,7 +397,16 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   }
 
   // the cones' boxes: project each cone's 3D box (clipped at the near plane),
-  // mark the pixels whose centres it may cover (plus 1 px)
+  // mark the pixels whose centres it may cover (plus 1 px). With the culling,
+  // only those whose rays meet the cone's bounding frustum: the others cannot
+  // hit the cone. Only where leaving a ray out changes nothing: on flat
+  // ground (a ray that meets no cone finds the ground or the sky, which the
+  // background already shows) and with no blocks (drawn only where rays are
+  // cast)
+  const bool cull = culling_ && flat_ground && world.block_count() == 0;
+  // the rays' origin as cast (float)
+  const double of[3] = {static_cast<float>(o[0]), static_cast<float>(o[1]), static_cast<float>(o[2])};
+  const double o_scale = std::max({std::abs(of[0]), std::abs(of[1]), std::abs(of[2])});
   read_cones(world);
   visible_.assign(world.cone_count(), 0);
   unoccluded_.assign(world.cone_count(), 0);
@@ -432,9 +459,35 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
     const int j1 = std::min(H - 1, static_cast<int>(std::floor(std::min(v1, lim_v + 2.0f) - 0.5f)) + 1);
     if (i0 > i1 || j0 > j1) continue;
     boxed_.push_back(static_cast<std::int32_t>(s));
+    // its frustum, grown by a margin from the magnitudes of the coordinates in play
+    float c_scale = 0.0f;
+    for (int a = 0; a < 3; ++a) c_scale = std::max({c_scale, std::abs(c.lo[a]), std::abs(c.hi[a])});
+    const double margin = kFrustumMargin + kFrustumRelMargin * (o_scale + c_scale);
+    ConeFrustum fr;
+    const bool test = cull && !c.split && cone_v_ != nullptr &&
+                      bounding_frustum(cone_v_, cone_idx_, c.prim, c.prim_end, is_standing(c) ? 2 : 0, margin, fr);
+    const FrustumRays rays(fr, of);
     for (int j = j0; j <= j1; ++j) {
       const std::size_t row = static_cast<std::size_t>(j) * static_cast<std::size_t>(W);
-      for (int i = i0; i <= i1; ++i) {
+      int a = i0, b = i1;
+      if (test) {
+        // the row's pixels whose rays meet the frustum are one run (the rays
+        // from o that meet a convex body fill a convex cone, whose cut with
+        // the plane of the row's rays is a wedge): from each end of the box's
+        // run inwards to the first pixel whose ray meets it. The ray is the
+        // pixel's before it is normalised and rounded to float, as ray_dir
+        // casts it
+        const double by = by_[static_cast<std::size_t>(j)];
+        const double dj[3] = {by * col[1][0] + col[2][0], by * col[1][1] + col[2][1], by * col[1][2] + col[2][2]};
+        const auto meets = [&](int i) {
+          const double ai = ax_[static_cast<std::size_t>(i)];
+          const double d[3] = {ai * col[0][0] + dj[0], ai * col[0][1] + dj[1], ai * col[0][2] + dj[2]};
+          return rays.meets(d);
+        };
+        while (a <= b && !meets(a)) ++a;
+        while (b > a && !meets(b)) --b;
+      }
+      for (int i = a; i <= b; ++i) {
         const std::size_t p = row + static_cast<std::size_t>(i);
         if (stamp_[p] != frame_) {
           stamp_[p] = frame_;
@@ -559,11 +612,13 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
       labelled_.push_back(p);
       ++visible_[static_cast<std::size_t>(cone)];
       ++unoccluded_[static_cast<std::size_t>(cone)];
-      if (cover_[p] < 2) return;  // no other cone's box: nothing behind to count
+      // no other cone's box (culling: frustum): nothing behind to count
+      if (cover_[p] < 2) return;
     }
-    // carried on: a cone hit where boxes overlap, or (non-flat) a ground hit
-    // in a box, which a hill may have put in front of the cone (not when the
-    // hit lies beyond every cone whose box holds the pixel)
+    // carried on: a cone hit where boxes (culling: frustums) overlap, or
+    // (non-flat) a ground hit in a box, which a hill may have put in front of
+    // the cone (not when the hit lies beyond every cone whose box holds the
+    // pixel)
     if (cone < 0 && t >= reach_[p]) return;
     carry_.push_back(p);
     carry_t_.push_back(static_cast<float>(t));

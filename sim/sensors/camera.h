@@ -35,25 +35,53 @@
 // world direction (sun_azimuth, sun_elevation); the sky a flat colour. No
 // shadows, no fog. Rounded to 8 bits, then optional Gaussian pixel noise.
 //
-// What is cast (the cost): cones are small, so on flat ground only the pixels
+// What is cast (the cost): cones are small, so on flat ground only pixels
 // inside the projected bounding boxes of the cones (their 3D axis-aligned
 // boxes' projections, clipped to the image, plus 1 px) are ray-cast; every
 // other pixel is filled analytically, row by row: ground (the plane z = 0
 // taken as unbounded, so rows just below the horizon show ground where the
 // scene's finite ground quad, 500 m past the cones, would show sky) below the
 // horizon, sky above. The flat ground's shading is one colour (normal up),
-// the same the cast pixels get. On a non-flat ground (a height field) the
-// boxes' pixels are cast as well, and the rest of the image in 4 x 4 px tiles:
-// one ray through a tile's middle pixel gives the colour of the tile's pixels
-// outside the boxes (sky, or the ground's facet shaded; so the horizon and the
-// ground's shading are 4 px coarse there, the cones and their surroundings
-// exact). That costs W H / 16 more rays on a large grid: about 5 ms a frame at
-// 800 x 500 (FSG 2023, 0.1 m bumps).
+// the same the cast pixels get.
+//
+// A cone covers about half its box, and a far cone's box is mostly its 1 px
+// margin, so on flat ground with no barrier blocks a box's pixel is cast
+// only if its ray meets the cone's bounding frustum (ConeFrustum,
+// bounding_frustum): a truncated circular cone about the cone's axis (world
+// +z standing, +x knocked, as cone_class tells them apart) built from the
+// mesh's vertices as read back: its ends the vertices' extent along the
+// axis, its radii there the farthest vertex from the axis in each half, kept
+// only if every vertex then lies within the radius at its height (else a
+// cylinder), grown by 1 mm plus 64 float epsilons of the coordinates'
+// magnitudes. It is convex and holds every vertex, so every triangle; the
+// margin is far more than Embree's float arithmetic can put a hit outside
+// its triangle, or the test's ray (the pixel's direction before it is
+// normalised and rounded to float) can stray from the ray cast. A pixel left
+// out is one whose ray would meet no cone, and on flat ground with no blocks
+// such a ray finds the ground or the sky: the background's colour, no label.
+// And a ray that hits a cone first is carried on (see Annotation) only if it
+// meets two or more frustums, as far as the farthest of their cones: the
+// cones whose frustums it misses it could not hit further on either. So the
+// frame is, bit for bit, the one casting every pixel of the boxes gives
+// (Camera::set_culling(false); tests/sensors/camera_test.cc compares the two
+// along FSG 2023 and near knocked, big and cut-off cones). The one thing
+// assumed of Embree is that a ray's hit does not depend on the other rays of
+// its packet, which change (LidarCast::Exploit assumes the same). Along FSG
+// 2023 (bench/camera_bench.cc) 4.3k rays a frame are cast instead of 11.2k.
+//
+// On a non-flat ground (a height field) every pixel of the boxes is cast
+// (their rays give their ground's shading), and the rest of the image in
+// 4 x 4 px tiles: one ray through a tile's middle pixel gives the colour of
+// the tile's pixels outside the boxes (sky, or the ground's facet shaded; so
+// the horizon and the ground's shading are 4 px coarse there, the cones and
+// their surroundings exact). That costs W H / 16 more rays on a large grid:
+// about 5 ms a frame at 800 x 500 (FSG 2023, 0.1 m bumps).
 //
 // The venue's barrier blocks are opaque and grey (the unknown cone's albedo):
 // where a ray meets one first, the cones behind it are hidden. They are drawn
-// only where rays are cast (in the cones' boxes; on non-flat ground also the
-// ground tiles'): elsewhere the image shows the analytic ground and sky.
+// only where rays are cast (in the cones' boxes, every pixel of them: no
+// culling; on non-flat ground also the ground tiles'): elsewhere the image
+// shows the analytic ground and sky.
 //
 // Annotation (CameraAnnotation). labels[p] = LidarWorld::cone_of of the first hit, -1 for ground
 // and sky. One CameraInstance per cone with >= 1 labelled pixel, in ascending
@@ -63,11 +91,12 @@
 // visible_fraction = visible pixels / unoccluded pixels. The unoccluded count
 // is exact w.r.t. the meshes: a pixel counts for a cone when its ray, carried
 // on through whatever it meets first, hits that cone. Only rays that hit a
-// cone first where two or more boxes overlap (and, on non-flat ground, rays
-// that hit the ground inside a box nearer than a cone whose box it is: a hill
-// can hide a cone) are carried on, one rtcIntersect1 per further surface, up
-// to the farthest corner of the cones boxing the pixel; on flat ground nothing
-// behind a ground hit can be seen, so those stop there.
+// cone first where two or more boxes overlap (with the culling: where the
+// ray meets two or more frustums; and, on non-flat ground, rays that hit the
+// ground inside a box nearer than a cone whose box it is: a hill can hide a
+// cone) are carried on, one rtcIntersect1 per further surface, up to the
+// farthest corner of those cones' boxes; on flat ground nothing behind a
+// ground hit can be seen, so those stop there.
 //
 // The cones' geometry (boxes, colour, axis) is read back from the scene's
 // Embree buffers each frame (vertex and index buffers of the cone geometry,
@@ -263,14 +292,25 @@ class Camera {
   std::size_t last_primary_rays() const { return last_primary_rays_; }
   std::size_t last_continued_rays() const { return last_continued_rays_; }
 
+  // for the tests and the benches: whether render() skips, where it provably
+  // changes nothing, the rays of the boxes' pixels that miss every cone's
+  // bounding frustum (see the top; on by default). Off, every pixel of a box
+  // is cast, as before the culling: the frames must be the same bit for bit
+  void set_culling(bool on) { culling_ = on; }
+  bool culling() const { return culling_; }
+
  private:
   // one cone of the scene, read back from its Embree buffers
   struct ConeGeom {
     std::int32_t id = -1;                        // cone index
-    unsigned prim = 0;                           // one of its triangles
+    unsigned prim = 0;                           // its first triangle
+    unsigned prim_end = 0;                       // one past its last
+    bool split = false;                          // its triangles are not contiguous
     float lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};  // world AABB
   };
   void read_cones(const LidarWorld& world);
+  // whether c stands (its axis world +z) or lies knocked (+x), from its box
+  static bool is_standing(const ConeGeom& c);
   ConeColor cone_class(const LidarWorld& world, const ConeGeom& c, double mid[3]) const;
   std::array<std::uint8_t, 3> shade(const Rgb& albedo, double lambert) const;
 
@@ -287,10 +327,13 @@ class Camera {
   // buffers reused between frames
   std::vector<ConeGeom> cones_;        // cones of the scene
   unsigned cone_geom_id_ = RTC_INVALID_GEOMETRY_ID;
+  const float* cone_v_ = nullptr;      // its vertex and index buffers (this frame)
+  const unsigned* cone_idx_ = nullptr;
+  bool culling_ = true;
   std::vector<std::int32_t> geom_of_;  // cone index -> cones_ slot (-1: none)
-  std::vector<std::uint32_t> stamp_;   // per pixel: frame_ when inside a box this frame
-  std::vector<std::uint8_t> cover_;    // per pixel: boxes covering it (saturating)
-  std::vector<float> reach_;           // per pixel: farthest corner of those boxes' cones (m)
+  std::vector<std::uint32_t> stamp_;   // per pixel: frame_ when cast this frame (in a box)
+  std::vector<std::uint8_t> cover_;    // per pixel: cones that may cover it (saturating)
+  std::vector<float> reach_;           // per pixel: farthest box corner of those cones (m)
   std::vector<std::uint32_t> cast_;    // pixels to cast
   std::vector<std::uint32_t> tiles_;   // non-flat ground: the tiles' middle pixels
   std::vector<std::uint32_t> carry_;   // pixels whose ray is carried on

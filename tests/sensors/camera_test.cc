@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "sim/world/track.h"
+#include "sim/world/venue.h"
 
 namespace paddock::sensors {
 namespace {
@@ -690,6 +691,146 @@ TEST(Camera, BoundingFrustumOfTheConeMeshes) {
   EXPECT_FALSE(bounding_frustum(vs.data(), is.data(), 3, 3, 2, 0.0, f));
   vs[4] = std::numeric_limits<float>::quiet_NaN();
   EXPECT_FALSE(bounding_frustum(vs.data(), is.data(), 0, static_cast<unsigned>(is.size() / 3), 2, 0.0, f));
+}
+
+// a camera culling its rays and one casting every pixel of the boxes render
+// the same poses (the culling one into reused buffers, as the runner does):
+// the same rgb, labels and instances to the bit, and no more rays. Returns
+// the primary rays each cast, summed over the poses.
+std::pair<std::size_t, std::size_t> expect_culling_changes_nothing(const LidarWorld& world, const CameraParams& p,
+                                                                   const std::vector<Pose2>& poses,
+                                                                   const std::string& what) {
+  Camera culled(p, 5), whole(p, 5);
+  EXPECT_TRUE(culled.culling());
+  whole.set_culling(false);
+  hal::CameraFrame frame;
+  CameraAnnotation annotation;
+  std::size_t rays_culled = 0, rays_whole = 0;
+  for (std::size_t k = 0; k < poses.size(); ++k) {
+    culled.render(world, poses[k], static_cast<TimeNs>(k), frame, annotation);
+    const AnnotatedFrame want = whole.render(world, poses[k], static_cast<TimeNs>(k));
+    EXPECT_TRUE(frame.rgb == want.frame.rgb) << what << ", pose " << k;
+    EXPECT_TRUE(annotation.labels == want.annotation.labels) << what << ", pose " << k;
+    EXPECT_EQ(annotation.instances.size(), want.annotation.instances.size()) << what << ", pose " << k;
+    for (std::size_t i = 0; i < std::min(annotation.instances.size(), want.annotation.instances.size()); ++i) {
+      const CameraInstance &a = annotation.instances[i], &b = want.annotation.instances[i];
+      EXPECT_EQ(a.id, b.id) << what << ", pose " << k;
+      EXPECT_EQ(a.color, b.color) << what << ", pose " << k;
+      EXPECT_EQ(a.range, b.range) << what << ", pose " << k;
+      EXPECT_EQ(a.visible_fraction, b.visible_fraction) << what << ", pose " << k << ", cone " << a.id;
+    }
+    EXPECT_LE(culled.last_primary_rays(), whole.last_primary_rays()) << what << ", pose " << k;
+    EXPECT_LE(culled.last_continued_rays(), whole.last_continued_rays()) << what << ", pose " << k;
+    rays_culled += culled.last_primary_rays();
+    rays_whole += whole.last_primary_rays();
+  }
+  std::printf("%s: %zu poses, %.0f rays a frame culled, %.0f not\n", what.c_str(), poses.size(),
+              static_cast<double>(rays_culled) / static_cast<double>(poses.size()),
+              static_cast<double>(rays_whole) / static_cast<double>(poses.size()));
+  return {rays_culled, rays_whole};
+}
+
+// along FSG 2023 at the default resolution: 240 poses on the centreline
+// looking along it (as bench/camera_bench.cc's), 240 more moved 1.5 m aside
+// and turned 35 deg in or out, so cones pass the image's edges and stand
+// close to the lens
+TEST(Camera, CullingGivesTheSameFramesAlongFsg2023) {
+  std::ifstream in(std::string(PADDOCK_SOURCE_DIR) + "/tracks/fsg_2023.csv");
+  std::stringstream text;
+  text << in.rdbuf();
+  const world::TrackModel track = world::build_track(world::parse_track(text.str(), "fsg_2023"));
+  LidarWorld world(track.cones);
+  std::vector<Pose2> poses;
+  const std::size_t m = track.centreline.size();
+  for (int k = 0; k < 240; ++k) {
+    const std::size_t i = m * static_cast<std::size_t>(k) / 240;
+    const Vec2 a = track.centreline[i], b = track.centreline[(i + 4) % m];
+    const double yaw = angle_of(b - a);
+    poses.push_back({a.x, a.y, yaw});
+    const double side = k % 2 == 0 ? 1.0 : -1.0, turn = k % 4 < 2 ? 1.0 : -1.0;
+    const Vec2 c = a + rotate({0.0, 1.5 * side}, yaw);
+    poses.push_back({c.x, c.y, yaw + turn * 35.0 * kPi / 180.0});
+  }
+  const auto [culled, whole] = expect_culling_changes_nothing(world, CameraParams{}, poses, "FSG 2023");
+  EXPECT_LT(culled, whole);
+}
+
+// a made-up scene: big orange cones a metre from the lens (cut by the
+// image's bottom edge), a cone beside the lens (its box straddles the lens's
+// plane), cones behind the camera, on the image's left and right edges,
+// knocked cones small and big (near, far, on an edge, in front of a standing
+// one), a row of cones hiding each other; seen from several places and
+// headings, with the default camera, a wide low one and with pixel noise
+TEST(Camera, CullingGivesTheSameFramesNearKnockedAndBigCones) {
+  std::vector<Cone> cones;
+  std::vector<bool> knocked;
+  const auto add = [&](double x, double y, ConeColor c, bool down = false) {
+    cones.push_back({{x, y}, c});
+    knocked.push_back(down);
+  };
+  // the lens at base (0.95, 0): big orange cones 1 m ahead and beside
+  add(1.95, 0.0, ConeColor::BigOrange);
+  add(2.1, 0.45, ConeColor::BigOrange);
+  add(2.3, -0.6, ConeColor::BigOrange, true);
+  add(0.95, 0.5, ConeColor::Blue);       // beside the lens
+  add(0.6, -0.4, ConeColor::Yellow);     // just behind it
+  add(-2.0, 0.0, ConeColor::BigOrange);  // behind the car
+  add(-6.0, 3.0, ConeColor::Blue, true);
+  // on the left and right edges (45 deg off the axis)
+  add(5.0, 4.05, ConeColor::Yellow);
+  add(5.0, -4.05, ConeColor::Blue);
+  add(9.0, 8.05, ConeColor::SmallOrange, true);
+  add(3.0, -2.0, ConeColor::BigOrange, true);
+  // a row along the axis, hiding each other, a knocked cone before the first
+  add(6.0, 0.2, ConeColor::Yellow, true);
+  add(7.0, 0.2, ConeColor::Blue);
+  add(7.6, 0.25, ConeColor::Yellow);
+  add(8.2, 0.15, ConeColor::BigOrange);
+  add(16.0, -1.5, ConeColor::Unknown, true);
+  add(30.0, 2.0, ConeColor::Blue);
+  LidarWorld world(cones, knocked);
+  std::vector<Pose2> poses;
+  for (double yaw : {0.0, 0.35, -0.35, 0.8, -0.8, 1.6, -2.4, kPi}) {
+    for (const Vec2 at : {Vec2{0.0, 0.0}, Vec2{0.6, -0.3}, Vec2{-1.0, 0.8}}) poses.push_back({at.x, at.y, yaw});
+  }
+  const auto [culled, whole] = expect_culling_changes_nothing(world, CameraParams{}, poses, "near cones");
+  EXPECT_LT(culled, whole);
+  CameraParams wide;
+  wide.width = 320;
+  wide.height = 240;
+  wide.hfov = 120.0 * kPi / 180.0;
+  wide.mount_z = 0.6;
+  wide.mount_pitch = 0.2;
+  expect_culling_changes_nothing(world, wide, poses, "near cones, wide low lens");
+  CameraParams noisy;
+  noisy.pixel_noise = 3.0;
+  expect_culling_changes_nothing(world, noisy, poses, "near cones, noisy");
+}
+
+// where the culling could change the frame it is off: on a height field
+// (the boxes' pixels take the ground's shading) and with barrier blocks
+// (drawn only where rays are cast): the same rays as without it
+TEST(Camera, NoCullingOnBumpyGroundOrWithBarrierBlocks) {
+  const std::vector<Cone> cones = {{{5.0, 1.0}, ConeColor::Blue},
+                                   {{5.0, -1.0}, ConeColor::Yellow},
+                                   {{9.0, 0.5}, ConeColor::BigOrange}};
+  GroundParams bumpy;
+  bumpy.bump_height = 0.2;
+  bumpy.bump_wavelength = 8.0;
+  world::Block block;
+  block.centre = {12.0, 0.0};
+  block.length = 2.0;
+  block.width = 0.5;
+  block.height = 0.8;
+  LidarWorld hills(cones, {}, bumpy);
+  LidarWorld walled(cones, {}, {}, {block});
+  ASSERT_EQ(walled.block_count(), 1u);
+  const std::vector<Pose2> poses = {{0.0, 0.0, 0.0}, {1.0, 0.5, -0.2}};
+  for (const LidarWorld* world : {&hills, &walled}) {
+    const auto [culled, whole] =
+        expect_culling_changes_nothing(*world, CameraParams{}, poses, world == &hills ? "bumpy" : "blocks");
+    EXPECT_EQ(culled, whole);
+  }
 }
 
 TEST(Camera, TriggerIsTheLidarColumnAtTheAzimuth) {
