@@ -4,9 +4,14 @@
 //                    800 x 500), from 50 poses spread along the centreline,
 //                    looking along it, one pose per iteration in turn;
 //                    target: well under 5 ms on one core (10 Hz camera, the
-//                    whole closed loop >= 20x real time)
-//   BM_CameraFrameBumpy  the same on a bumpy ground (height field: the boxes'
-//                    pixels plus a ray per 4 x 4 tile)
+//                    whole closed loop >= 20x real time). Flat ground: the
+//                    boxes' pixels whose rays meet a cone's bounding frustum
+//                    are cast (camera.h)
+//   BM_CameraFrameUnculled  the same casting every pixel of the boxes
+//                    (Camera::set_culling(false)): the frames are the same,
+//                    the difference is what the culling saves
+//   BM_CameraFrameBumpy  the same on a bumpy ground (height field: every
+//                    pixel of the boxes plus a ray per 4 x 4 tile)
 //   BM_CameraFrameNoisy  the same with 2 levels of pixel noise
 //   BM_Detector      sensors::AnnotationDetector::detect on such a frame and
 //                    its annotation (a pass over the labels, the error model)
@@ -58,10 +63,11 @@ void report(benchmark::State& state, std::vector<double>& ms) {
 }
 
 void camera_frames(benchmark::State& state, const sensors::GroundParams& ground,
-                   const sensors::CameraParams& params = {}) {
+                   const sensors::CameraParams& params = {}, bool culling = true) {
   const world::TrackModel track = fsg_2023();
   const sensors::LidarWorld world(track.cones, {}, ground);
   sensors::Camera camera(params, 1);
+  camera.set_culling(culling);
   const std::vector<Pose2> poses = poses_along(track, 50);
   hal::CameraFrame frame;
   sensors::CameraAnnotation annotation;
@@ -85,6 +91,9 @@ void camera_frames(benchmark::State& state, const sensors::GroundParams& ground,
 
 void BM_CameraFrame(benchmark::State& state) { camera_frames(state, {}); }
 BENCHMARK(BM_CameraFrame)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+void BM_CameraFrameUnculled(benchmark::State& state) { camera_frames(state, {}, {}, false); }
+BENCHMARK(BM_CameraFrameUnculled)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 void BM_CameraFrameBumpy(benchmark::State& state) {
   sensors::GroundParams g;
