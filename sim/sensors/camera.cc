@@ -351,6 +351,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   out.stamp = stamp;
   out.width = W;
   out.height = H;
+  const bool same_image = out.rgb.size() == 3 * n_px && out.rgb.data() == rgb_buffer_;
   out.rgb.resize(3 * n_px);
   // the labels: -1 everywhere; when the buffer is the one this camera wrote
   // last frame (as the runner passes it), only the pixels it labelled then
@@ -362,6 +363,13 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   }
   labels_buffer_ = annotation.labels.data();
   labelled_.clear();
+  // the image likewise: when the buffer is the one this camera wrote last
+  // frame and that frame was the flat ground's background (the same every
+  // frame: it depends on the mount's pitch alone) with painted_ drawn on it,
+  // only those pixels differ from the background
+  const bool background_kept = same_image && flat_background_;
+  rgb_buffer_ = out.rgb.data();
+  flat_background_ = false;
   annotation.instances.clear();
   last_primary_rays_ = last_continued_rays_ = 0;
   if (!finite(base_pose.x) || !finite(base_pose.y) || !finite(base_pose.yaw)) {
@@ -390,11 +398,19 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
 
   // background, row by row: with no roll the x axis is level, so a row's rays
   // all point up (sky) or all down (flat ground)
-  for (int j = 0; j < H; ++j) {
-    const double dz = by_[static_cast<std::size_t>(j)] * col[1][2] + col[2][2];
-    const std::vector<std::uint8_t>& row = (flat_ground && dz < 0.0) ? ground_row_ : sky_row_;
-    std::copy(row.begin(), row.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(j) * W);
+  const auto ground_row = [&](std::size_t j) { return flat_ground && by_[j] * col[1][2] + col[2][2] < 0.0; };
+  if (background_kept && flat_ground) {
+    for (std::uint32_t p : painted_) {
+      const std::array<std::uint8_t, 3>& rgb = ground_row(p / static_cast<std::uint32_t>(W)) ? ground_rgb_ : sky_rgb_;
+      std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
+    }
+  } else {
+    for (int j = 0; j < H; ++j) {
+      const std::vector<std::uint8_t>& row = ground_row(static_cast<std::size_t>(j)) ? ground_row_ : sky_row_;
+      std::copy(row.begin(), row.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(j) * W);
+    }
   }
+  painted_.clear();
 
   // the cones' boxes: project each cone's 3D box (clipped at the near plane),
   // mark the pixels whose centres it may cover (plus 1 px). With the culling,
@@ -599,6 +615,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
     if (cone == kHitStructure) {  // a barrier block: opaque, nothing behind it counts
       const std::array<std::uint8_t, 3> rgb = shade(albedo(params_, LidarMaterial::Barrier), lambert_of(rh, k));
       std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
+      painted_.push_back(p);
       return;
     }
     const LidarMaterial m =
@@ -607,6 +624,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
                                      o[1] + t * rh.ray.dir_y[k], o[2] + t * rh.ray.dir_z[k]);
     const std::array<std::uint8_t, 3> rgb = shade(albedo(params_, m), lambert_of(rh, k));
     std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
+    painted_.push_back(p);
     if (cone >= 0) {
       annotation.labels[p] = cone;
       labelled_.push_back(p);
@@ -682,6 +700,8 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
       byte = static_cast<std::uint8_t>(std::clamp(v, 0, 255));
     }
   }
+  // (flat ground: the tiles paint no pixel; noise touches every one)
+  flat_background_ = flat_ground && noise_.empty();
 }
 
 }  // namespace paddock::sensors

@@ -279,7 +279,9 @@ class Camera {
   // the same into `out` and `annotation`, reusing their buffers (no
   // allocation once sized). When annotation.labels is the buffer of this
   // camera's last call, unchanged since, only the pixels it labelled then
-  // are reset (anything else must not write into it)
+  // are reset; when out.rgb is, and that frame was flat ground's without
+  // noise, only the pixels its rays drew are (anything else must not write
+  // into either)
   void render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp, hal::CameraFrame& out,
               CameraAnnotation& annotation);
 
@@ -343,6 +345,9 @@ class Camera {
   std::uint32_t frame_ = 0;
   const std::int32_t* labels_buffer_ = nullptr;  // the labels buffer of the last frame
   std::vector<std::uint32_t> labelled_;          // and its pixels >= 0
+  const std::uint8_t* rgb_buffer_ = nullptr;     // the image buffer of the last frame
+  bool flat_background_ = false;                 // it was the flat background with painted_ drawn on
+  std::vector<std::uint32_t> painted_;           // the pixels cast rays drew last frame
   std::size_t last_primary_rays_ = 0, last_continued_rays_ = 0;
 };
 

@@ -402,28 +402,45 @@ TEST(Camera, ReusedBuffersGiveTheFramesFreshOnesGive) {
   std::stringstream text;
   text << in.rdbuf();
   const world::TrackModel track = world::build_track(world::parse_track(text.str(), "fsg_2023"));
-  for (double bump : {0.0, 0.3}) {
-    GroundParams g;
-    g.bump_height = bump;
-    g.bump_wavelength = 8.0;
-    LidarWorld world(track.cones, {}, g);
+  // one camera and one pair of buffers through frames of a flat world, a
+  // bumpy one and a flat one with barrier blocks (their pixels drawn too),
+  // in turn, with a non-finite pose among them; with and without pixel
+  // noise: each frame as fresh buffers give it (a twin camera, the same
+  // calls, its own random stream alike)
+  GroundParams bumpy;
+  bumpy.bump_height = 0.3;
+  bumpy.bump_wavelength = 8.0;
+  std::vector<world::Block> blocks;
+  for (std::size_t i = 0; i < track.cones.size(); i += 9) {
+    world::Block b;
+    b.centre = track.cones[i].position + Vec2{1.5, 0.0};
+    b.length = 1.0;
+    b.width = 0.5;
+    b.height = 0.8;
+    blocks.push_back(b);
+  }
+  const LidarWorld flat_world(track.cones), bumpy_world(track.cones, {}, bumpy), walled(track.cones, {}, {}, blocks);
+  const LidarWorld* worlds[] = {&flat_world, &flat_world, &bumpy_world, &flat_world, &walled, &flat_world};
+  for (double noise : {0.0, 2.0}) {
     CameraParams p;
     p.width = 320;
     p.height = 200;
+    p.pixel_noise = noise;
     Camera reused(p, 1), fresh(p, 1);
     hal::CameraFrame frame;
     CameraAnnotation annotation;
     const std::size_t m = track.centreline.size();
-    int labelled_frames = 0;
-    for (int s = 0; s < 12; ++s) {
-      const std::size_t i = m * static_cast<std::size_t>(s) / 12;
+    int labelled_frames = 0, barrier_frames = 0;
+    for (int s = 0; s < 24; ++s) {
+      const LidarWorld& world = *worlds[s % 6];
+      const std::size_t i = m * static_cast<std::size_t>(s) / 24;
       const Vec2 a = track.centreline[i], b = track.centreline[(i + 4) % m];
       Pose2 pose{a.x, a.y, angle_of(b - a)};
       if (s == 7) pose.yaw = std::nan("");
       reused.render(world, pose, s, frame, annotation);
       const AnnotatedFrame want = fresh.render(world, pose, s);
-      EXPECT_TRUE(frame.rgb == want.frame.rgb) << "bump " << bump << ", pose " << s;
-      EXPECT_TRUE(annotation.labels == want.annotation.labels) << "bump " << bump << ", pose " << s;
+      EXPECT_TRUE(frame.rgb == want.frame.rgb) << "noise " << noise << ", frame " << s;
+      EXPECT_TRUE(annotation.labels == want.annotation.labels) << "noise " << noise << ", frame " << s;
       ASSERT_EQ(annotation.instances.size(), want.annotation.instances.size()) << s;
       for (std::size_t k = 0; k < want.annotation.instances.size(); ++k) {
         EXPECT_EQ(annotation.instances[k].id, want.annotation.instances[k].id);
@@ -431,8 +448,21 @@ TEST(Camera, ReusedBuffersGiveTheFramesFreshOnesGive) {
       }
       labelled_frames += std::any_of(want.annotation.labels.begin(), want.annotation.labels.end(),
                                      [](std::int32_t l) { return l >= 0; });
+      // a block drawn: a pixel of neither the sky's nor the flat ground's colour, and no cone's
+      if (&world == &walled && noise == 0.0) {
+        const hal::CameraFrame empty = Camera(p, 1).render(flat_world, pose, s).frame;
+        bool drawn = false;
+        for (std::size_t q = 0; q < want.annotation.labels.size() && !drawn; ++q) {
+          drawn = want.annotation.labels[q] < 0 && (want.frame.rgb[3 * q] != empty.rgb[3 * q] ||
+                                                     want.frame.rgb[3 * q + 2] != empty.rgb[3 * q + 2]);
+        }
+        barrier_frames += drawn;
+      }
     }
-    EXPECT_GE(labelled_frames, 10) << "bump " << bump;  // cones in (nearly) every frame
+    EXPECT_GE(labelled_frames, 20) << "noise " << noise;  // cones in (nearly) every frame
+    if (noise == 0.0) {
+      EXPECT_GE(barrier_frames, 2);  // and the blocks drawn where they were
+    }
   }
 }
 
