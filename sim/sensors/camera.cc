@@ -255,6 +255,9 @@ std::array<std::uint8_t, 3> Camera::shade(const Rgb& a, double lambert) const {
 }
 
 void Camera::read_cones(const LidarWorld& world) {
+  // a world's cones never move: read once per world
+  if (world.serial() == cones_world_) return;
+  cones_world_ = world.serial();
   cones_.clear();
   cone_geom_id_ = RTC_INVALID_GEOMETRY_ID;
   cone_v_ = nullptr;

@@ -328,6 +328,7 @@ class Camera {
   std::vector<std::int16_t> noise_;    // pixel noise quantiles (empty: no noise)
   // buffers reused between frames
   std::vector<ConeGeom> cones_;        // cones of the scene
+  std::uint64_t cones_world_ = 0;      // read from the world of this serial (0: none yet)
   unsigned cone_geom_id_ = RTC_INVALID_GEOMETRY_ID;
   const float* cone_v_ = nullptr;      // its vertex and index buffers (this frame)
   const unsigned* cone_idx_ = nullptr;

@@ -1,6 +1,7 @@
 #include "sim/sensors/lidar.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cmath>
 #include <cstring>
@@ -228,6 +229,8 @@ GroundShape ground_shape(const GroundParams& g, double x, double y) {
 LidarWorld::LidarWorld(const std::vector<Cone>& cones, const std::vector<bool>& knocked,
                        const GroundParams& ground, const std::vector<world::Block>& blocks)
     : ground_(ground) {
+  static std::atomic<std::uint64_t> built{0};
+  serial_ = ++built;
   if (!knocked.empty() && knocked.size() != cones.size()) {
     throw std::invalid_argument("LidarWorld: knocked must be empty or of the size of cones");
   }

@@ -251,6 +251,9 @@ class LidarWorld {
 
   // the whole scene: the ground, the cones and the blocks
   RTCScene scene() const { return scene_; }
+  // this world's number, unique among the worlds the process built (a
+  // scene rebuilt may sit at the old one's address: this tells them apart)
+  std::uint64_t serial() const { return serial_; }
   std::size_t cone_count() const { return cone_count_; }
   std::size_t block_count() const { return block_count_; }
   const GroundParams& ground() const { return ground_; }
@@ -275,6 +278,7 @@ class LidarWorld {
  private:
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  std::uint64_t serial_ = 0;
   std::size_t cone_count_ = 0;
   std::size_t block_count_ = 0;
   GroundParams ground_;
