@@ -121,9 +121,14 @@ struct PoseGraphParams {
   // coordinate at once, so each moved less). With Huber's loss LM closes
   // in linearly: on a two-lap window of the default run the steps after
   // the fifth are 1e-3 .. 1e-6 and cost as much as the first five (11-12
-  // iterations to Ceres' cost test; 6-7 to 0.1 mm, all of them < 0.1 mm
-  // from the end). 0: off
-  double step_tolerance = 1e-4;
+  // iterations to Ceres' cost test; 6-7 to 1e-4, all of them < 0.1 mm
+  // from the end; the run's localisation 10 % cheaper). Off by default:
+  // any change of the graph's result moves the closed loop chaotically,
+  // and on the noisy CI scenario (fsg_2023_trackdrive_noisy.ini, 24 seeds)
+  // the seeds with a cone hit changed from 7 (off) to 6 (1e-4) and 13
+  // (1e-5), the CI seeds among them: the scenario sits at its margin in
+  // FSG 2023's 3.3 m wide hairpin, whatever the solver's stop. 0: off
+  double step_tolerance = 0.0;
 
   // the graph's user adds a node when the odometry moved this far (or
   // turned this much) since the last one: 1 m keeps the midpoint rule's

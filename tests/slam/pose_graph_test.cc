@@ -341,6 +341,7 @@ TEST(PoseGraph, TheStepTestEndsWithinItsToleranceOfTheFullSolve) {
     quick.range_std = 0.02;
     quick.range_std_per_m = 0.01;
     quick.bearing_std = 0.2 * kPi / 180.0;
+    quick.step_tolerance = 1e-4;
     PoseGraphParams full = quick;
     full.step_tolerance = 0.0;
     const SensorNoise noise{2.0 * quick.range_std, 2.0 * quick.range_std_per_m, 2.0 * quick.bearing_std};
@@ -464,7 +465,7 @@ TEST(PoseGraph, CeresSolutionEqualsADenseGaussNewton) {
   const Small s = small_problem();
   PoseGraphParams p;
   p.huber_scale = 0.0;  // plain least squares: the objective Gauss-Newton minimises
-  p.step_tolerance = 0.0;  // to the end, as the reference goes (the step test: below)
+  p.step_tolerance = 0.0;  // to the end, as the reference goes (the default; the step test: above)
   PoseGraph g(p);
   Eigen::VectorXd x0(20);
   for (int i = 0; i < 5; ++i) {
