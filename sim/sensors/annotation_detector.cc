@@ -58,6 +58,32 @@ std::vector<TightBox> tight_boxes(const hal::CameraFrame& f, const CameraAnnotat
     if (!slot.emplace(id, k).second) return fail("malformed frame: duplicate instance id " + std::to_string(id));
     boxes[k].id = id;
   }
+  if (a.listed) {
+    // the listed pixels alone: every labelled one, in no set order
+    for (const std::uint32_t p : a.labelled) {
+      const std::int32_t id = p < n ? a.labels[p] : -1;
+      const auto it = id >= 0 ? slot.find(id) : slot.end();
+      if (it == slot.end()) {
+        std::ostringstream os;
+        os << "malformed frame: listed pixel " << p << " has label " << id << " and no instance";
+        return fail(os.str());
+      }
+      TightBox& t = boxes[it->second];
+      const int i = static_cast<int>(p % static_cast<std::uint32_t>(f.width));
+      const int j = static_cast<int>(p / static_cast<std::uint32_t>(f.width));
+      if (t.pixels == 0) {
+        t.i_min = t.i_max = i;
+        t.j_min = t.j_max = j;
+      } else {
+        t.i_min = std::min(t.i_min, i);
+        t.i_max = std::max(t.i_max, i);
+        t.j_min = std::min(t.j_min, j);
+        t.j_max = std::max(t.j_max, j);
+      }
+      ++t.pixels;
+    }
+    return boxes;
+  }
   std::int32_t last_id = -1;
   TightBox* b = nullptr;
   // most pixels show no cone (-1, every bit set): a block of them whose

@@ -98,7 +98,9 @@ struct TightBox {
 
 // the tight boxes of the annotation's instances (in annotation.instances'
 // order, one per instance, pixels = 0 for one with no labelled pixel); "" in
-// *error or the reason the frame cannot be read (then the result is empty)
+// *error or the reason the frame cannot be read (then the result is empty).
+// From the annotation's list of labelled pixels when it has one (the
+// camera's), else from every label
 std::vector<TightBox> tight_boxes(const hal::CameraFrame& frame, const CameraAnnotation& annotation,
                                   std::string* error);
 

@@ -375,6 +375,8 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   flat_background_ = false;
   annotation.instances.clear();
   last_primary_rays_ = last_continued_rays_ = 0;
+  annotation.listed = true;  // (the list is labelled_, copied at the end)
+  annotation.labelled.clear();
   if (!finite(base_pose.x) || !finite(base_pose.y) || !finite(base_pose.yaw)) {
     std::fill(out.rgb.begin(), out.rgb.end(), std::uint8_t{0});
     return;
@@ -705,6 +707,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   }
   // (flat ground: the tiles paint no pixel; noise touches every one)
   flat_background_ = flat_ground && noise_.empty();
+  annotation.labelled.assign(labelled_.begin(), labelled_.end());
 }
 
 }  // namespace paddock::sensors

@@ -210,6 +210,11 @@ struct CameraInstance {
 struct CameraAnnotation {
   std::vector<std::int32_t> labels;
   std::vector<CameraInstance> instances;
+  // when listed: the pixels whose label is >= 0, each once, in no set order
+  // (the camera lists what it labelled, so a reader need not scan the
+  // frame's mostly empty labels); not listed: read the labels
+  bool listed = false;
+  std::vector<std::uint32_t> labelled;
 };
 
 // one rendered frame: what the camera gives, and what only the simulation knows of it

@@ -6,12 +6,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <random>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "sim/sensors/camera.h"
+#include "sim/world/track.h"
 
 namespace paddock::sensors {
 namespace {
@@ -149,6 +152,53 @@ TEST(AnnotationDetector, TightBoxesAgreeWithABruteForceScanOfScatteredLabels) {
       EXPECT_EQ(b.j_max, j_max) << w << " " << id;
     }
   }
+}
+
+// the camera lists the pixels it labelled: the tight boxes from that list
+// are those of a scan of every label, over frames along FSG 2023; and a
+// list that names an unlabelled pixel or one out of the frame is malformed
+TEST(AnnotationDetector, TheCamerasListOfLabelledPixelsGivesTheBoxesOfAFullScan) {
+  std::ifstream in(std::string(PADDOCK_SOURCE_DIR) + "/tracks/fsg_2023.csv");
+  std::stringstream text;
+  text << in.rdbuf();
+  const world::TrackModel track = world::build_track(world::parse_track(text.str(), "fsg_2023"));
+  const LidarWorld world(track.cones);
+  Camera cam(CameraParams{}, 1);
+  hal::CameraFrame frame;
+  CameraAnnotation annotation;
+  const std::size_t m = track.centreline.size();
+  std::size_t boxes_seen = 0;
+  for (int s = 0; s < 20; ++s) {
+    const std::size_t i = m * static_cast<std::size_t>(s) / 20;
+    const Vec2 a = track.centreline[i], b = track.centreline[(i + 4) % m];
+    cam.render(world, Pose2{a.x, a.y, angle_of(b - a)}, s, frame, annotation);
+    ASSERT_TRUE(annotation.listed);
+    CameraAnnotation scanned = annotation;
+    scanned.listed = false;
+    std::string e1, e2;
+    const std::vector<TightBox> listed = tight_boxes(frame, annotation, &e1), full = tight_boxes(frame, scanned, &e2);
+    ASSERT_TRUE(e1.empty() && e2.empty()) << e1 << e2;
+    ASSERT_EQ(listed.size(), full.size());
+    for (std::size_t k = 0; k < full.size(); ++k) {
+      EXPECT_EQ(listed[k].id, full[k].id);
+      EXPECT_EQ(listed[k].pixels, full[k].pixels) << s << " " << k;
+      if (full[k].pixels == 0) continue;
+      ++boxes_seen;
+      EXPECT_EQ(listed[k].i_min, full[k].i_min);
+      EXPECT_EQ(listed[k].i_max, full[k].i_max);
+      EXPECT_EQ(listed[k].j_min, full[k].j_min);
+      EXPECT_EQ(listed[k].j_max, full[k].j_max);
+    }
+  }
+  EXPECT_GT(boxes_seen, 400u);
+  CameraAnnotation bad = annotation;
+  bad.labelled.push_back(0);  // the top-left pixel: sky, unlabelled
+  std::string error;
+  EXPECT_TRUE(tight_boxes(frame, bad, &error).empty());
+  EXPECT_NE(error.find("listed pixel"), std::string::npos) << error;
+  bad.labelled.back() = static_cast<std::uint32_t>(annotation.labels.size());
+  EXPECT_TRUE(tight_boxes(frame, bad, &error).empty());
+  EXPECT_NE(error.find("listed pixel"), std::string::npos) << error;
 }
 
 TEST(AnnotationDetector, MissCurveIsTheDocumentedOne) {
