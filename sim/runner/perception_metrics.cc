@@ -47,7 +47,11 @@ void PerceptionMetrics::add(const hal::ConeDetections& perceived, const Pose2& b
   for (std::size_t i = 0; i < seen.size(); ++i) {
     if (!std::isfinite(seen[i].x) || !std::isfinite(seen[i].y)) continue;
     for (std::size_t j = 0; j < truth.size(); ++j) {
-      const double d = distance(seen[i], truth[j].position);
+      // (a coordinate apart by more than the radius is out: hypot is never
+      // below either one; most of the track's cones are, and hypot is slow)
+      const Vec2 e = seen[i] - truth[j].position;
+      if (std::abs(e.x) > match_radius_ || std::abs(e.y) > match_radius_) continue;
+      const double d = norm(e);
       if (d <= match_radius_) pairs.emplace_back(d, i, j);
     }
   }
