@@ -240,9 +240,9 @@ void Localisation::optimise_graph() {
       if (const std::optional<Vec2> l = graph.landmark(id)) position = *l;
     }
     // the loop closed on the optimised map: fewer particles localise in it
-    const int closed = params_.fastslam.closed_particles;
+    // (reanchor takes 0 for the full set)
     fastslam_->reanchor(nodes_.back().estimate, map, std::numeric_limits<std::int64_t>::max(),
-                        closed > 0 ? closed : params_.fastslam.particles);
+                        params_.fastslam.closed_particles);
   }
   stats_.optimise_ms.push_back(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
