@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <unordered_map>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -278,15 +277,23 @@ Pose2 Lio::predict_base_pose(TimeNs t) {
 std::vector<Vector3d> Lio::deskew(const std::vector<hal::LidarPoint>& points, const Isometry3d& imu_lidar,
                                   const std::vector<Knot>& knots) {
   std::vector<Vector3d> out;
-  out.reserve(points.size());
-  if (knots.empty()) return out;
-  const Knot& end = knots.back();
-  const Matrix3d Re_t = end.x.R.transpose();
+  deskew(points.data(), points.data() + points.size(), imu_lidar, knots, out);
+  return out;
+}
+
+void Lio::deskew(const hal::LidarPoint* begin, const hal::LidarPoint* end, const Isometry3d& imu_lidar,
+                 const std::vector<Knot>& knots, std::vector<Vector3d>& out) {
+  out.clear();
+  if (knots.empty()) return;
+  out.reserve(static_cast<std::size_t>(end - begin));
+  const Knot& last = knots.back();
+  const Matrix3d Re_t = last.x.R.transpose();
   std::size_t k = 0;
   TimeNs at = std::numeric_limits<TimeNs>::min();
   Matrix3d Rc;  // end <- IMU at the point's time, and the IMU's origin there
   Vector3d tc;
-  for (const hal::LidarPoint& q : points) {
+  for (const hal::LidarPoint* it = begin; it != end; ++it) {
+    const hal::LidarPoint& q = *it;
     if (q.t != at) {
       // the interval [knots[k], knots[k+1]) holding the point's time (points
       // in time order; a column's points share theirs)
@@ -296,12 +303,11 @@ std::vector<Vector3d> Lio::deskew(const std::vector<hal::LidarPoint>& points, co
       Matrix3d Ri;
       moved(a.x, a.omega, a.accel, to_seconds(q.t - a.t), pi, vi, Ri);
       Rc = Re_t * Ri;
-      tc = Re_t * (pi - end.x.p);
+      tc = Re_t * (pi - last.x.p);
       at = q.t;
     }
     out.push_back(Rc * (imu_lidar * Vector3d(q.x, q.y, q.z)) + tc);
   }
-  return out;
 }
 
 double Lio::plane_residual(const LioState& x, const Vector3d& p_imu, const Vector3d& n, double d,
@@ -416,13 +422,75 @@ LioStatus Lio::update(const std::vector<Vector3d>& points) {
   return LioStatus::Ok;
 }
 
+void Lio::down_sample(const hal::LidarPoint* slice, std::vector<Vector3d>& pts) {
+  // one point a leaf: the first of it in counter-clockwise azimuth order
+  // about the sensor's axis (ties, a column's rings within the float
+  // points' rounding: the first in time), whichever way the head spins. Time
+  // order is that order only for a counter-clockwise head; which edge of its
+  // leaf the kept point lies on moves the estimate (FSG 2023 autocross with
+  // barriers, LIO: a clockwise head kept the first in time order, the other
+  // edge, at ATE rms 0.05 m against 0.02 m). The points grouped by leaf (a
+  // sort of (leaf, index): no allocation, no hash table), each leaf's taken
+  // in time order: its first, replaced by a later one more than the tie
+  // before it in azimuth. The leaves are kept in a flat hash table of
+  // (leaf, point kept, its azimuth), reused slice after slice (an entry
+  // stamped with another slice's number is empty): no allocation, and an
+  // azimuth is computed only where a leaf meets its second point
+  constexpr double kLeafAzimuthTie = 1e-5;  // rad
+  const double leaf = params_.scan_leaf;
+  const auto cell = [leaf](double c) {
+    return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(c / leaf)) & 0x1fffff);
+  };
+  std::size_t size = 64;
+  while (size < 2 * pts.size()) size *= 2;
+  if (leaves_.size() < size) leaves_.assign(size, LeafEntry{});
+  const std::size_t mask = leaves_.size() - 1;
+  if (++leaf_stamp_ == 0) {  // wrapped: every stamp is stale again
+    std::fill(leaves_.begin(), leaves_.end(), LeafEntry{});
+    leaf_stamp_ = 1;
+  }
+  const std::uint32_t stamp = leaf_stamp_;
+  const auto azimuth = [slice](std::size_t i) { return static_cast<double>(std::atan2(slice[i].y, slice[i].x)); };
+  leaf_kept_.assign(pts.size(), 0);
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Vector3d& q = pts[i];
+    const std::uint64_t key = cell(q.x()) | (cell(q.y()) << 21) | (cell(q.z()) << 42);
+    std::uint64_t h = key * 0x9E3779B97F4A7C15ull;
+    h ^= h >> 29;
+    std::size_t j = static_cast<std::size_t>(h) & mask;
+    while (leaves_[j].stamp == stamp && leaves_[j].key != key) j = (j + 1) & mask;
+    LeafEntry& e = leaves_[j];
+    if (e.stamp != stamp) {
+      e = {key, stamp, static_cast<std::uint32_t>(i), false, 0.0};
+      continue;
+    }
+    if (!e.has_azimuth) {
+      e.azimuth = azimuth(e.kept);
+      e.has_azimuth = true;
+    }
+    const double a = azimuth(i);
+    if (a < e.azimuth - kLeafAzimuthTie) {
+      e.kept = static_cast<std::uint32_t>(i);
+      e.azimuth = a;
+    }
+  }
+  // kept in time order, in place (each kept index is at least its position)
+  for (const LeafEntry& e : leaves_)
+    if (e.stamp == stamp) leaf_kept_[e.kept] = 1;
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    if (leaf_kept_[i]) pts[n++] = pts[i];
+  pts.resize(n);
+}
+
 LioStatus Lio::on_scan(const hal::LidarScan& scan) {
   const LioParams& pr = params_;
   ++stats_.scans;
   if (imu_.empty() || imu_.back().stamp < scan.stamp) return LioStatus::NoImu;
   if (!started_) initialise_from_rest(scan.stamp);
   // the usable points (finite, in range, not before the state's time)
-  std::vector<hal::LidarPoint> usable;
+  std::vector<hal::LidarPoint>& usable = usable_;
+  usable.clear();
   usable.reserve(scan.points.size());
   for (const hal::LidarPoint& q : scan.points) {
     const double r2 = static_cast<double>(q.x) * q.x + static_cast<double>(q.y) * q.y + static_cast<double>(q.z) * q.z;
@@ -433,14 +501,17 @@ LioStatus Lio::on_scan(const hal::LidarScan& scan) {
     if (r2 < pr.min_range * pr.min_range || r2 > pr.max_range * pr.max_range) continue;
     usable.push_back(q);
   }
-  std::stable_sort(usable.begin(), usable.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
+  const auto earlier = [](const hal::LidarPoint& a, const hal::LidarPoint& b) { return a.t < b.t; };
+  if (!std::is_sorted(usable.begin(), usable.end(), earlier)) std::stable_sort(usable.begin(), usable.end(), earlier);
 
   // slice by slice: propagate, deskew, down-sample, update (LIMO-Velo)
-  std::vector<Vector3d> to_map;
+  std::vector<Vector3d>& to_map = to_map_;
+  to_map.clear();
   LioStatus status = LioStatus::Ok;
   const TimeNs slice_ns = std::max<TimeNs>(1, from_seconds(pr.slice));
   std::size_t begin = 0;
-  std::vector<Knot> knots;
+  std::vector<Knot>& knots = knots_;
+  std::vector<Vector3d>& pts = slice_points_;
   while (begin < usable.size()) {
     const TimeNs slice_end = usable[begin].t + slice_ns;
     std::size_t end = begin;
@@ -448,37 +519,9 @@ LioStatus Lio::on_scan(const hal::LidarScan& scan) {
     const TimeNs t2 = usable[end - 1].t;
     knots.clear();
     propagate_to(std::max(t2, t_), &knots);
-    slice_.assign(usable.begin() + static_cast<std::ptrdiff_t>(begin), usable.begin() + static_cast<std::ptrdiff_t>(end));
-    std::vector<Vector3d> pts = deskew(slice_, imu_lidar_, knots);
-    // one point a leaf: the first of it in counter-clockwise azimuth order
-    // about the sensor's axis (ties, a column's rings within the float
-    // points' rounding: the first in time), whichever way the
-    // head spins. Time order is that order only for a counter-clockwise
-    // head; which edge of its leaf the kept point lies on moves the estimate
-    // (FSG 2023 autocross with barriers, LIO: a clockwise head kept the
-    // first in time order, the other edge, at ATE rms 0.05 m against 0.02 m)
-    if (pr.scan_leaf > 0.0) {
-      constexpr double kLeafAzimuthTie = 1e-5;  // rad
-      std::unordered_map<std::uint64_t, std::size_t>& best = leaf_best_;
-      best.clear();
-      leaf_azimuth_.resize(slice_.size());
-      for (std::size_t i = 0; i < slice_.size(); ++i) leaf_azimuth_[i] = std::atan2(slice_[i].y, slice_[i].x);
-      const auto cell = [&](double c) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(c / pr.scan_leaf)) & 0x1fffff); };
-      for (std::size_t i = 0; i < pts.size(); ++i) {
-        const Vector3d& q = pts[i];
-        const std::uint64_t key = cell(q.x()) | (cell(q.y()) << 21) | (cell(q.z()) << 42);
-        const auto [it, fresh] = best.emplace(key, i);
-        if (!fresh && leaf_azimuth_[i] < leaf_azimuth_[it->second] - kLeafAzimuthTie) it->second = i;
-      }
-      // kept in time order
-      leaf_kept_.clear();
-      for (const auto& [key, i] : best) leaf_kept_.push_back(i);
-      std::sort(leaf_kept_.begin(), leaf_kept_.end());
-      std::vector<Vector3d> kept;
-      kept.reserve(leaf_kept_.size());
-      for (const std::size_t i : leaf_kept_) kept.push_back(pts[i]);
-      pts.swap(kept);
-    }
+    const hal::LidarPoint* slice = usable.data() + begin;
+    deskew(slice, usable.data() + end, imu_lidar_, knots, pts);
+    if (pr.scan_leaf > 0.0) down_sample(slice, pts);
     ++stats_.slices;
     if (!has_map_) {
       status = LioStatus::Initialising;

@@ -81,7 +81,6 @@
 #include <cstdint>
 #include <deque>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -260,6 +259,9 @@ class Lio {
   // the knots' last time
   static std::vector<Eigen::Vector3d> deskew(const std::vector<hal::LidarPoint>& points,
                                              const Eigen::Isometry3d& imu_lidar, const std::vector<Knot>& knots);
+  // the same for [begin, end) into out (cleared first)
+  static void deskew(const hal::LidarPoint* begin, const hal::LidarPoint* end, const Eigen::Isometry3d& imu_lidar,
+                     const std::vector<Knot>& knots, std::vector<Eigen::Vector3d>& out);
   // one point-to-plane residual and its Jacobian over (dtheta, dp) at state x
   // for a point in the IMU frame and a plane n . x + d = 0 (n unit)
   static double plane_residual(const LioState& x, const Eigen::Vector3d& p_imu, const Eigen::Vector3d& n, double d,
@@ -274,6 +276,9 @@ class Lio {
   Pose2 base_pose_of(const LioState& x) const;
   bool fit_plane(const Eigen::Vector3d& p_world, Eigen::Vector3d& n, double& d);
   void initialise_from_rest(TimeNs t);
+  // a slice's deskewed points (slice: the same points as the LiDAR gave
+  // them) down to one a scan_leaf leaf, in time order
+  void down_sample(const hal::LidarPoint* slice, std::vector<Eigen::Vector3d>& pts);
 
   LioParams params_;
   Eigen::Isometry3d imu_lidar_;
@@ -299,10 +304,23 @@ class Lio {
     bool valid = false;
   };
   std::vector<Plane> planes_;  // update's, per point
-  std::vector<hal::LidarPoint> slice_;        // on_scan's current slice
-  std::unordered_map<std::uint64_t, std::size_t> leaf_best_;  // its down-sampling's leaves: the point kept
-  std::vector<double> leaf_azimuth_;                          // its points' azimuths (rad, sensor frame)
-  std::vector<std::size_t> leaf_kept_;                         // the kept points, in time order
+  // on_scan's: the scan's usable points, a slice's knots and deskewed
+  // points, the rotation's points for the map
+  std::vector<hal::LidarPoint> usable_;
+  std::vector<Knot> knots_;
+  std::vector<Eigen::Vector3d> slice_points_, to_map_;
+  // down_sample's: its leaves (a flat hash table, entries of the slice
+  // numbered leaf_stamp_ in use) and which points it kept
+  struct LeafEntry {
+    std::uint64_t key = 0;
+    std::uint32_t stamp = 0;
+    std::uint32_t kept = 0;
+    bool has_azimuth = false;
+    double azimuth = 0.0;
+  };
+  std::vector<LeafEntry> leaves_;
+  std::uint32_t leaf_stamp_ = 0;
+  std::vector<std::uint8_t> leaf_kept_;
 };
 
 }  // namespace paddock::slam

@@ -163,6 +163,12 @@ std::uint32_t VoxelMap::add_voxel(const Key& key) {
   Voxel& x = pool_[v];
   x.key = key;
   x.live = true;
+  if (index_.size() == 0) {
+    lo_ = hi_ = key;
+  } else {
+    lo_ = {std::min(lo_.x, key.x), std::min(lo_.y, key.y), std::min(lo_.z, key.z)};
+    hi_ = {std::max(hi_.x, key.x), std::max(hi_.y, key.y), std::max(hi_.z, key.z)};
+  }
   index_.insert(key, v);
   push_front(v);
   return v;
@@ -274,10 +280,12 @@ int VoxelMap::knn(const Eigen::Vector3d& query, int k, double max_distance, std:
     gap2[a][2] = above * above;
   }
 
+  // the farthest a point may lie and still enter the list: max_distance,
+  // and once the list is full its last
+  double bound = limit;
   for (int i = 0; i < searched_; ++i) {
     const Key& o = offsets_[static_cast<std::size_t>(i)];
     const double box2 = gap2[0][o.x + 1] + gap2[1][o.y + 1] + gap2[2][o.z + 1];
-    const double bound = out.size() == kk ? std::min(limit, out.back().distance2) : limit;
     if (box2 > bound) continue;
     const std::uint32_t v = index_.find({qk.x + o.x, qk.y + o.y, qk.z + o.z});
     if (v == kNone) continue;
@@ -286,8 +294,7 @@ int VoxelMap::knn(const Eigen::Vector3d& query, int k, double max_distance, std:
       const double dy = static_cast<double>(s.y) - q[1];
       const double dz = static_cast<double>(s.z) - q[2];
       const double d2 = (dx * dx + dy * dy) + dz * dz;
-      if (d2 > limit) continue;
-      if (out.size() == kk && d2 > out.back().distance2) continue;
+      if (d2 > bound) continue;
       const Eigen::Vector3d p(s.x, s.y, s.z);
       if (out.size() == kk) {
         if (!before(d2, p, out.back())) continue;
@@ -298,6 +305,7 @@ int VoxelMap::knn(const Eigen::Vector3d& query, int k, double max_distance, std:
       // insertion into the sorted list
       for (std::size_t j = out.size() - 1; j > 0 && before(out[j].distance2, out[j].point, out[j - 1]); --j)
         std::swap(out[j], out[j - 1]);
+      if (out.size() == kk) bound = std::min(limit, out.back().distance2);
     }
   }
   return static_cast<int>(out.size());
@@ -310,6 +318,21 @@ std::size_t VoxelMap::remove_outside(const Eigen::Vector3d& centre, double reach
   const double inner = reach - kBoxMargin;
   const double outer = reach + kBoxMargin;
   std::size_t removed = 0;
+  if (index_.size() == 0) return 0;
+  // every voxel ever added lies in [lo_, hi_]: when that box is wholly
+  // inside, so is each voxel (the box's faces are its extreme voxels' faces,
+  // computed alike), and none need be looked at
+  if (inner > 0.0) {
+    const std::int32_t lo[3] = {lo_.x, lo_.y, lo_.z}, hi[3] = {hi_.x, hi_.y, hi_.z};
+    double far2 = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      const double low = static_cast<double>(lo[a]) * voxel_;
+      const double high = static_cast<double>(hi[a]) * voxel_ + voxel_;
+      const double far = std::max(c[a] - low, high - c[a]);
+      far2 += far * far;
+    }
+    if (far2 <= inner * inner) return 0;
+  }
   // slot order, never the hash table's
   for (std::uint32_t v = 0; v < pool_.size(); ++v) {
     Voxel& x = pool_[v];

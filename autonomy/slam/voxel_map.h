@@ -237,6 +237,7 @@ class VoxelMap {
   std::vector<Voxel> pool_;
   std::vector<std::uint32_t> free_;
   std::uint32_t head_ = kNone, tail_ = kNone;
+  Key lo_{}, hi_{};  // every voxel added since the map was empty lies in [lo_, hi_]
   std::size_t points_ = 0;
   std::size_t rejected_ = 0;
 };
