@@ -283,13 +283,8 @@ int VoxelMap::knn(const Eigen::Vector3d& query, int k, double max_distance, std:
   // the farthest a point may lie and still enter the list: max_distance,
   // and once the list is full its last
   double bound = limit;
-  for (int i = 0; i < searched_; ++i) {
-    const Key& o = offsets_[static_cast<std::size_t>(i)];
-    const double box2 = gap2[0][o.x + 1] + gap2[1][o.y + 1] + gap2[2][o.z + 1];
-    if (box2 > bound) continue;
-    const std::uint32_t v = index_.find({qk.x + o.x, qk.y + o.y, qk.z + o.z});
-    if (v == kNone) continue;
-    for (const Slot& s : pool_[v].points) {
+  const auto search = [&](const std::vector<Slot>& points) {
+    for (const Slot& s : points) {
       const double dx = static_cast<double>(s.x) - q[0];
       const double dy = static_cast<double>(s.y) - q[1];
       const double dz = static_cast<double>(s.z) - q[2];
@@ -307,7 +302,28 @@ int VoxelMap::knn(const Eigen::Vector3d& query, int k, double max_distance, std:
         std::swap(out[j], out[j - 1]);
       if (out.size() == kk) bound = std::min(limit, out.back().distance2);
     }
+  };
+  // the query's own voxel first: its points set the bound
+  if (const std::uint32_t v = index_.find(qk); v != kNone) search(pool_[v].points);
+  // then the neighbours still within it, looked up together (their table
+  // probes and points are fetched from memory side by side, not one after
+  // the other), searched in order; a neighbour the bound has since passed
+  // is skipped
+  const std::vector<Slot>* found[26];
+  double found_box2[26];
+  int n = 0;
+  for (int i = 1; i < searched_; ++i) {
+    const Key& o = offsets_[static_cast<std::size_t>(i)];
+    const double box2 = gap2[0][o.x + 1] + gap2[1][o.y + 1] + gap2[2][o.z + 1];
+    if (box2 > bound) continue;
+    const std::uint32_t v = index_.find({qk.x + o.x, qk.y + o.y, qk.z + o.z});
+    if (v == kNone) continue;
+    found[n] = &pool_[v].points;
+    __builtin_prefetch(found[n]->data());
+    found_box2[n++] = box2;
   }
+  for (int i = 0; i < n; ++i)
+    if (!(found_box2[i] > bound)) search(*found[i]);
   return static_cast<int>(out.size());
 }
 
