@@ -140,7 +140,19 @@ struct LioParams {
   int min_matches = 20;               // fewer planes: no update
   double degeneracy_threshold = 0.02;  // least eigenvalue of H^T H / m over the pose
 
-  VoxelMapParams map;
+  // the point map: FAST-LIO2's voxel map, but a leaf keeps its first point
+  // (replace = false). Replacing a leaf's point by one nearer its centre
+  // lets every pass re-place the map at the pose the odometry has drifted
+  // to, so the map creeps with it lap after lap: FSG 2023 trackdrive, the
+  // CI's LIO scenario, seeds 1-6, ATE rms 0.141 m mean replacing, 0.115 m
+  // keeping (each seed better, by 0.010-0.044 m); on the paper's stack
+  // (seeds 4-6) 0.123 against 0.106 m; the autocross, FS Spain 2019 and
+  // barrier scenarios alike or better (seeds 1-3)
+  VoxelMapParams map = [] {
+    VoxelMapParams m;
+    m.replace = false;
+    return m;
+  }();
 
   template <class V>
   void visit(V& v) {

@@ -239,7 +239,7 @@ VoxelMap::InsertResult VoxelMap::insert(const std::vector<Eigen::Vector3d>& poin
         const double d = q[a] - (static_cast<double>(leaf_of[a]) + 0.5) * leaf;
         old2 += d * d;
       }
-      if (d2 < old2) {
+      if (params_.replace && d2 < old2) {
         *same = slot;
         ++r.replaced;
       } else {

@@ -9,7 +9,8 @@
 // holds at most one map point: FAST-LIO2's down-sampling, where a point is
 // inserted only when its leaf is empty or holds a point farther from the
 // leaf's centre (the new one then replaces it), so the map keeps, in each
-// leaf, the inserted point nearest its centre.
+// leaf, the inserted point nearest its centre; with replace = false a leaf
+// keeps the first point it was given.
 //
 // A query looks at the query's voxel and its neighbours (nearby: the 6 face
 // neighbours, 18 with the edges, or all 26), nearest boxes first, skips a
@@ -126,6 +127,10 @@ struct VoxelMapParams {
   // (18.8k voxels, 209k points, 7.5 MB of heap: ~400 bytes a voxel), so
   // ~80 MB at most
   int max_voxels = 200000;
+  // a point nearer its leaf's centre replaces the one there (FAST-LIO2's
+  // down-sampling); false: a leaf keeps its first point for good (the
+  // LIO's map: see LioParams::map)
+  bool replace = true;
 
   template <class V>
   void visit(V& v) {
@@ -134,6 +139,7 @@ struct VoxelMapParams {
     v(PADDOCK_PARAM(max_points_per_voxel), {"", params::in(1, 1000000), "a voxel holding this many points takes no more"});
     v(PADDOCK_PARAM(nearby), kNearbyNames, "the voxels a query searches: the query's and its 6 face, 18 face and edge, or all 26 neighbours");
     v(PADDOCK_PARAM(reach), {"m", params::above(0.0), "remove_outside keeps the points within this distance of its centre"});
+    v(PADDOCK_PARAM(replace), "a point nearer its leaf's centre replaces the one there (false: the first stays)");
     v(PADDOCK_PARAM(max_voxels), {"", params::in(1, 100000000), "beyond this many voxels the least recently inserted-into one is removed"});
   }
   std::string check() const;

@@ -184,6 +184,45 @@ TEST(VoxelMap, AnInsertReplacesOnlyAPointFartherFromTheLeafsCentre) {
   EXPECT_EQ(map.voxels(), 2u);
 }
 
+TEST(VoxelMap, WithoutReplacementALeafKeepsItsFirstPoint) {
+  // the LIO's map (replace = false): the same points as above, in a random
+  // cloud too; every leaf holds the first point it was given, and only that
+  VoxelMapParams p;
+  p.leaf_size = 0.125;
+  p.replace = false;
+  VoxelMap map(p);
+  EXPECT_EQ(map.insert({{0.015625, 0.0625, 0.0625}}).added, 1);
+  EXPECT_EQ(map.insert({{0.03125, 0.0625, 0.0625}}).skipped, 1);  // nearer the centre, yet the first stays
+  std::vector<Neighbour> out;
+  ASSERT_EQ(map.knn({0.25, 0.25, 0.25}, 1, 1.0, out), 1);
+  EXPECT_EQ(out[0].point, Vec3(0.015625, 0.0625, 0.0625));
+
+  VoxelMapParams q;
+  q.replace = false;
+  q.max_points_per_voxel = 1000;
+  VoxelMap cloud_map(q);
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::map<std::array<long long, 3>, Vec3> first;  // brute force: a leaf's first point (as float)
+  long replaced = 0;
+  for (int batch = 0; batch < 4; ++batch) {
+    std::vector<Vec3> pts;
+    for (int i = 0; i < 1000; ++i) pts.emplace_back(u(rng), u(rng), u(rng));
+    replaced += cloud_map.insert(pts).replaced;
+    for (const Vec3& v : pts) {
+      const Vec3 r = rounded(v);
+      first.emplace(std::array<long long, 3>{static_cast<long long>(std::floor(r.x() / 0.1)),
+                                             static_cast<long long>(std::floor(r.y() / 0.1)),
+                                             static_cast<long long>(std::floor(r.z() / 0.1))},
+                    r);
+    }
+  }
+  EXPECT_EQ(replaced, 0);
+  std::vector<Vec3> want;
+  for (const auto& [leaf, v] : first) want.push_back(v);
+  EXPECT_EQ(sorted(cloud_map.points()), sorted(want));
+}
+
 // the leaf is the rounded point's: 0.5 - 1e-12 is stored as 0.5, in the
 // leaf [0.5, 0.6) of the point at its centre 0.55 (each axis in turn)
 TEST(VoxelMap, DecisionsAreTakenOnThePointRoundedToFloat) {
