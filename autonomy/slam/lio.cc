@@ -429,8 +429,7 @@ void Lio::down_sample(const hal::LidarPoint* slice, std::vector<Vector3d>& pts) 
   // order is that order only for a counter-clockwise head; which edge of its
   // leaf the kept point lies on moves the estimate (FSG 2023 autocross with
   // barriers, LIO: a clockwise head kept the first in time order, the other
-  // edge, at ATE rms 0.05 m against 0.02 m). The points grouped by leaf (a
-  // sort of (leaf, index): no allocation, no hash table), each leaf's taken
+  // edge, at ATE rms 0.05 m against 0.02 m). Each leaf's points are taken
   // in time order: its first, replaced by a later one more than the tie
   // before it in azimuth. The leaves are kept in a flat hash table of
   // (leaf, point kept, its azimuth), reused slice after slice (an entry
