@@ -461,6 +461,7 @@ void Lio::down_sample(const hal::LidarPoint* slice, std::vector<Vector3d>& pts) 
     LeafEntry& e = leaves_[j];
     if (e.stamp != stamp) {
       e = {key, stamp, static_cast<std::uint32_t>(i), false, 0.0};
+      leaf_kept_[i] = 1;
       continue;
     }
     if (!e.has_azimuth) {
@@ -469,13 +470,13 @@ void Lio::down_sample(const hal::LidarPoint* slice, std::vector<Vector3d>& pts) 
     }
     const double a = azimuth(i);
     if (a < e.azimuth - kLeafAzimuthTie) {
+      leaf_kept_[e.kept] = 0;
+      leaf_kept_[i] = 1;
       e.kept = static_cast<std::uint32_t>(i);
       e.azimuth = a;
     }
   }
   // kept in time order, in place (each kept index is at least its position)
-  for (const LeafEntry& e : leaves_)
-    if (e.stamp == stamp) leaf_kept_[e.kept] = 1;
   std::size_t n = 0;
   for (std::size_t i = 0; i < pts.size(); ++i)
     if (leaf_kept_[i]) pts[n++] = pts[i];

@@ -233,11 +233,14 @@ VoxelMap::InsertResult VoxelMap::insert(const std::vector<Eigen::Vector3d>& poin
     std::vector<Slot>& pts = pool_[v].points;
     auto same = std::find_if(pts.begin(), pts.end(), [number](const Slot& s) { return s.leaf == number; });
     if (same != pts.end()) {
+      // without replacement the leaf's first point stays, however near
       double old2 = 0.0;
-      const double q[3] = {same->x, same->y, same->z};
-      for (int a = 0; a < 3; ++a) {
-        const double d = q[a] - (static_cast<double>(leaf_of[a]) + 0.5) * leaf;
-        old2 += d * d;
+      if (params_.replace) {
+        const double q[3] = {same->x, same->y, same->z};
+        for (int a = 0; a < 3; ++a) {
+          const double d = q[a] - (static_cast<double>(leaf_of[a]) + 0.5) * leaf;
+          old2 += d * d;
+        }
       }
       if (params_.replace && d2 < old2) {
         *same = slot;
