@@ -27,7 +27,10 @@ CarLog::CarLog(const std::string& path, const std::vector<File>& attachments, co
   for (const File& f : attachments)
     mcap_->write_attachment({0, 0, f.name, f.media_type, std::vector<std::uint8_t>(f.data.begin(), f.data.end())});
   mcap_->write_metadata("paddock", metadata);
-  if (lidar) decoder_ = std::make_unique<hal::ouster::Decoder>(*lidar, layout);
+  if (lidar) {
+    decoder_ = std::make_unique<hal::ouster::Decoder>(*lidar, layout);
+    decoder_->set_scan_every(kPointCloudEvery);  // the other rotations' points are not needed
+  }
 
   packets_ = channel("/lidar/packets", "", "ouster.lidar_packet.legacy");
   can_rx_ = channel("/can/rx", "", "socketcan.can_frame");
@@ -99,13 +102,13 @@ void CarLog::lidar_packet(TimeNs at, const std::uint8_t* data, std::size_t size)
   write(packets_, at, data, size);
   if (!decoder_) return;
   decoder_->push(data, size);
+  // every kPointCloudEvery-th rotation (the decoder scans no other)
   while (std::optional<hal::LidarScan> scan = decoder_->pop()) {
-    if (rotations_++ % kPointCloudEvery != 0) continue;
     // in the sensor frame as it stood (raw: not deskewed)
-    std::vector<float> xyzi;
-    xyzi.reserve(4 * scan->points.size());
-    for (const hal::LidarPoint& p : scan->points) xyzi.insert(xyzi.end(), {p.x, p.y, p.z, p.intensity});
-    write(points_, at, fg::point_cloud(scan->end, "lidar", xyzi).dump());
+    xyzi_.clear();
+    for (const hal::LidarPoint& p : scan->points) xyzi_.insert(xyzi_.end(), {p.x, p.y, p.z, p.intensity});
+    fg::point_cloud(scan->end, "lidar", xyzi_.data(), scan->points.size(), text_);
+    write(points_, at, text_);
   }
 }
 
@@ -123,7 +126,8 @@ void CarLog::message(TimeNs at, const hal::SensorMessage& m) {
 }
 
 void CarLog::image(TimeNs at, TimeNs stamp, const std::vector<std::uint8_t>& jpeg) {
-  write(image_, at, fg::compressed_image(stamp, "camera", jpeg, "jpeg").dump());
+  fg::compressed_image(stamp, "camera", jpeg.data(), jpeg.size(), "jpeg", text_);
+  write(image_, at, text_);
 }
 
 void CarLog::cycle(TimeNs at, const hal::ActuatorCommand& c, const stack::Stack& stack) {

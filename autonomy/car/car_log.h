@@ -84,7 +84,8 @@ class CarLog {
   std::uint16_t packets_ = 0, can_rx_ = 0, can_tx_ = 0, detections_ = 0, cones_ = 0, state_ = 0, tf_ = 0,
                 pose_ = 0, command_ = 0, map_ = 0, path_ = 0, points_ = 0, image_ = 0;
   bool mounted_ = false;  // base -> lidar written
-  long rotations_ = 0;
+  std::vector<float> xyzi_;  // a cloud's points, kept for the next
+  std::string text_;         // a message's JSON text, kept for the next
   std::optional<TimeNs> next_pose_, next_map_, next_path_;
   const void* path_of_ = nullptr;  // the trajectory last logged (its points' storage)
   std::size_t path_points_ = 0;

@@ -680,12 +680,16 @@ void Decoder::close() {
     ++counters_.partial_first;
   } else {
     counters_.lost_columns += static_cast<std::uint64_t>(window_size_ - received_);
-    ++counters_.rotations;
-    done_.push_back(scan(image_));
+    if (counters_.rotations++ % static_cast<std::uint64_t>(scan_every_) == 0) done_.push_back(scan(image_));
   }
   first_ = false;
   last_closed_ = image_.frame_id;
   open_ = false;
+}
+
+void Decoder::set_scan_every(int n) {
+  if (n < 1) throw std::invalid_argument("ouster::Decoder: a scan every " + std::to_string(n) + " rotations");
+  scan_every_ = n;
 }
 
 void Decoder::flush() {

@@ -156,6 +156,12 @@ class Decoder {
   // constructed, without building the angle tables again
   void reset();
   const Counters& counters() const { return counters_; }
+  // only every n-th rotation emitted becomes a scan (the first, the
+  // (n+1)-th, ...: counters().rotations counts them all), for a reader that
+  // wants a few (the log's point clouds): the others cost the copy of their
+  // columns, not their points. n >= 1 (else std::invalid_argument); 1, the
+  // default: every rotation. reset() keeps it
+  void set_scan_every(int n);
 
   // the points of a rotation: column by column in measurement_id order,
   // rings ascending, returns only; stamp and end the first and last valid
@@ -191,6 +197,7 @@ class Decoder {
   bool first_ = true;  // no rotation closed yet
   int late_run_ = 0;   // late columns in a row
   std::uint16_t last_closed_ = 0;
+  int scan_every_ = 1;
   std::deque<LidarScan> done_;
   Counters counters_;
 };

@@ -1,7 +1,6 @@
 #include "autonomy/log/foxglove.h"
 
 #include <cmath>
-#include <cstring>
 
 namespace paddock::log::foxglove {
 
@@ -43,6 +42,18 @@ json entity(TimeNs at, const char* id, json cylinders, json lines) {
                   {"lifetime", stamp(0)},      {"frame_locked", false}, {"cylinders", std::move(cylinders)},
                   {"lines", std::move(lines)}};
   return {{"deletions", json::array()}, {"entities", json::array({e})}};
+}
+
+// `fields` (an object) with "data": the n bytes in base64, as the JSON text
+// dump() gives: nlohmann's objects keep their keys sorted (std::map), and
+// "data" sorts before the fields' names, so it opens the object
+void with_data(const json& fields, const std::uint8_t* data, std::size_t n, std::string& out) {
+  const std::string rest = fields.dump();  // {"...": ...}: small
+  out.assign("{\"data\":\"");
+  out.reserve(out.size() + (n + 2) / 3 * 4 + rest.size() + 1);
+  append_base64(out, data, n);
+  out += "\",";
+  out.append(rest, 1, std::string::npos);
 }
 
 }  // namespace
@@ -108,8 +119,9 @@ std::string compressed_image_schema() {
                 "foxglove.CompressedImage");
 }
 
-json compressed_image(TimeNs at, const char* frame, const std::vector<std::uint8_t>& data, const char* format) {
-  return {{"timestamp", stamp(at)}, {"frame_id", frame}, {"data", base64(data.data(), data.size())}, {"format", format}};
+void compressed_image(TimeNs at, const char* frame, const std::uint8_t* data, std::size_t n, const char* format,
+                      std::string& out) {
+  with_data({{"timestamp", stamp(at)}, {"frame_id", frame}, {"format", format}}, data, n, out);
 }
 
 std::string object_schema(const char* title, json properties) { return titled(object_of(std::move(properties)), title); }
@@ -173,40 +185,46 @@ json line_update(const std::vector<Vec2>& points, bool closed, TimeNs at, const 
   return entity(at, id, json::array(), json::array({line}));
 }
 
-json point_cloud(TimeNs at, const char* frame, const std::vector<float>& xyzi) {
-  std::vector<std::uint8_t> bytes(xyzi.size() * sizeof(float));
-  if (!xyzi.empty()) std::memcpy(bytes.data(), xyzi.data(), bytes.size());
+void point_cloud(TimeNs at, const char* frame, const float* xyzi, std::size_t points, std::string& out) {
   json fields = json::array();
   const char* names[4] = {"x", "y", "z", "intensity"};
   for (int k = 0; k < 4; ++k) fields.push_back({{"name", names[k]}, {"offset", 4 * k}, {"type", 7}});  // 7: float32
-  return {{"timestamp", stamp(at)},
-          {"frame_id", frame},
-          {"pose", pose(0.0, 0.0, 0.0, 0.0)},
-          {"point_stride", 16},
-          {"fields", fields},
-          {"data", base64(bytes.data(), bytes.size())}};
+  // the floats' bytes as they lie in memory (little-endian, as the schema's float32)
+  with_data({{"timestamp", stamp(at)},
+             {"frame_id", frame},
+             {"pose", pose(0.0, 0.0, 0.0, 0.0)},
+             {"point_stride", 16},
+             {"fields", fields}},
+            reinterpret_cast<const std::uint8_t*>(xyzi), 4 * sizeof(float) * points, out);
 }
 
 std::string base64(const std::uint8_t* p, std::size_t n) {
-  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
-  out.reserve((n + 2) / 3 * 4);
+  append_base64(out, p, n);
+  return out;
+}
+
+void append_base64(std::string& out, const std::uint8_t* p, std::size_t n) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  // the text's room made at once, then written through a pointer
+  const std::size_t start = out.size();
+  out.resize(start + (n + 2) / 3 * 4);
+  char* o = &out[start];
   std::size_t i = 0;
   for (; i + 2 < n; i += 3) {
     const std::uint32_t v = (std::uint32_t{p[i]} << 16) | (std::uint32_t{p[i + 1]} << 8) | p[i + 2];
-    out += k[(v >> 18) & 63];
-    out += k[(v >> 12) & 63];
-    out += k[(v >> 6) & 63];
-    out += k[v & 63];
+    *o++ = k[(v >> 18) & 63];
+    *o++ = k[(v >> 12) & 63];
+    *o++ = k[(v >> 6) & 63];
+    *o++ = k[v & 63];
   }
   if (i < n) {
     const std::uint32_t v = (std::uint32_t{p[i]} << 16) | (i + 1 < n ? std::uint32_t{p[i + 1]} << 8 : 0u);
-    out += k[(v >> 18) & 63];
-    out += k[(v >> 12) & 63];
-    out += i + 1 < n ? k[(v >> 6) & 63] : '=';
-    out += '=';
+    *o++ = k[(v >> 18) & 63];
+    *o++ = k[(v >> 12) & 63];
+    *o++ = i + 1 < n ? k[(v >> 6) & 63] : '=';
+    *o++ = '=';
   }
-  return out;
 }
 
 }  // namespace paddock::log::foxglove

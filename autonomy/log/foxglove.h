@@ -49,11 +49,16 @@ json pose_in_frame(TimeNs at, const char* frame, double x, double y, double yaw)
 json cones_update(const std::vector<Cone>& cones, TimeNs at, const char* id);
 // foxglove.SceneUpdate: a line strip `id` through the points (z = 2 cm), closed if asked
 json line_update(const std::vector<Vec2>& points, bool closed, TimeNs at, const char* id);
-// foxglove.PointCloud of float32 x, y, z, intensity per point, in `frame`
-json point_cloud(TimeNs at, const char* frame, const std::vector<float>& xyzi);
-// foxglove.CompressedImage: an image's bytes in `format` ("jpeg") in `frame`
-json compressed_image(TimeNs at, const char* frame, const std::vector<std::uint8_t>& data, const char* format);
-// RFC 4648 base64 (a JSON `bytes` field)
+// the two messages with a `bytes` field, as their JSON text into `out`
+// (replaced; its storage kept for the next): the text json::dump() gives,
+// the field's base64 spliced in rather than escaped character by character
+// foxglove.PointCloud of `points` float32 x, y, z, intensity (xyzi: 4 a point), in `frame`
+void point_cloud(TimeNs at, const char* frame, const float* xyzi, std::size_t points, std::string& out);
+// foxglove.CompressedImage: an image's n bytes in `format` ("jpeg") in `frame`
+void compressed_image(TimeNs at, const char* frame, const std::uint8_t* data, std::size_t n, const char* format,
+                      std::string& out);
+// RFC 4648 base64 (a JSON `bytes` field); appended to `out`
 std::string base64(const std::uint8_t* p, std::size_t n);
+void append_base64(std::string& out, const std::uint8_t* p, std::size_t n);
 
 }  // namespace paddock::log::foxglove

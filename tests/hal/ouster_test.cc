@@ -797,6 +797,27 @@ TEST(OusterAssembly, ResetIsANewDecoder) {
   EXPECT_EQ(std::memcmp(&used.counters(), &fresh.counters(), sizeof(Decoder::Counters)), 0);
 }
 
+// a scan every third rotation: the first, the fourth, the seventh, as a
+// decoder of every rotation gives them; every rotation counted
+TEST(OusterAssembly, AScanEveryNthRotationIsThatRotationsScan) {
+  Stream st;
+  Decoder every(st.info, st.layout), third(st.info, st.layout);
+  third.set_scan_every(3);
+  for (std::uint16_t f = 10; f < 17; ++f) {
+    const std::vector<Bytes> p = packets_of(st.info, st.image(f));
+    push_all(every, p);
+    push_all(third, p);
+  }
+  every.flush();
+  third.flush();
+  const std::vector<LidarScan> all = drain(every), some = drain(third);
+  ASSERT_EQ(all.size(), 7u);
+  ASSERT_EQ(some.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) expect_same(some[k], all[3 * k]);
+  EXPECT_EQ(third.counters().rotations, 7u);
+  EXPECT_THROW(third.set_scan_every(0), std::invalid_argument);
+}
+
 TEST(OusterAssembly, FrameIdWrapsAround) {
   Stream st;
   const std::uint16_t frames[] = {65534, 65535, 0, 1};
