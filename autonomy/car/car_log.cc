@@ -134,22 +134,33 @@ void CarLog::cycle(TimeNs at, const hal::ActuatorCommand& c, const stack::Stack&
   if (!mounted_) {
     // where the LiDAR sits on the car
     mounted_ = true;
-    write(tf_, at, fg::transform(at, "base", "lidar", layout_.mount_x, layout_.mount_y, layout_.mount_z, 0.0,
-                                 layout_.mount_pitch).dump());
+    fg::transform(at, "base", "lidar", layout_.mount_x, layout_.mount_y, layout_.mount_z, 0.0, layout_.mount_pitch,
+                  text_);
+    write(tf_, at, text_);
   }
-  write(command_, at,
-        json{{"stamp", c.stamp}, {"steering_angle", c.steering_angle}, {"throttle", c.throttle}, {"brake", c.brake},
-             {"yaw_moment", c.yaw_moment}, {"as_state", hal::to_string(c.as_state)}}
-            .dump());
+  // the command (its keys in the order json::dump() sorts them)
+  fg::JsonWriter(text_)
+      .begin_object()
+      .key("as_state").string(hal::to_string(c.as_state))
+      .key("brake").number(c.brake)
+      .key("stamp").integer(c.stamp)
+      .key("steering_angle").number(c.steering_angle)
+      .key("throttle").number(c.throttle)
+      .key("yaw_moment").number(c.yaw_moment)
+      .end_object();
+  write(command_, at, text_);
   const std::optional<hal::StateEstimate>& e = stack.estimate();
   if (e && (!next_pose_ || at >= *next_pose_)) {
     next_pose_ = at + pose_period_;
-    write(pose_, at, fg::pose_in_frame(e->stamp, "map", e->pose.x, e->pose.y, e->pose.yaw).dump());
-    write(tf_, at, fg::transform(e->stamp, "map", "base", e->pose.x, e->pose.y, 0.0, e->pose.yaw).dump());
+    fg::pose_in_frame(e->stamp, "map", e->pose.x, e->pose.y, e->pose.yaw, text_);
+    write(pose_, at, text_);
+    fg::transform(e->stamp, "map", "base", e->pose.x, e->pose.y, 0.0, e->pose.yaw, 0.0, text_);
+    write(tf_, at, text_);
   }
   if (!next_map_ || at >= *next_map_) {
     next_map_ = at + kNsPerSecond;
-    write(map_, at, fg::cones_update(stack.cone_map().cones(), at, "stack_map").dump());
+    fg::cones_update(stack.cone_map().cones(), at, "stack_map", text_);
+    write(map_, at, text_);
   }
   // the trajectory when it changed, at most twice a second
   const Trajectory& tr = stack.trajectory();

@@ -1,6 +1,11 @@
 #include "autonomy/log/foxglove.h"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 
 namespace paddock::log::foxglove {
 
@@ -27,13 +32,16 @@ std::string titled(json s, const char* title) {
   return s.dump();
 }
 
-json cone_color(ConeColor c) {
+// a cone's r, g, b as drawn
+const double* cone_rgb(ConeColor c) {
+  static const double blue[3] = {0.1, 0.3, 1.0}, yellow[3] = {1.0, 0.85, 0.0}, small_orange[3] = {1.0, 0.5, 0.0},
+                      big_orange[3] = {1.0, 0.35, 0.0}, other[3] = {0.6, 0.6, 0.6};
   switch (c) {
-    case ConeColor::Blue: return rgba(0.1, 0.3, 1.0);
-    case ConeColor::Yellow: return rgba(1.0, 0.85, 0.0);
-    case ConeColor::SmallOrange: return rgba(1.0, 0.5, 0.0);
-    case ConeColor::BigOrange: return rgba(1.0, 0.35, 0.0);
-    default: return rgba(0.6, 0.6, 0.6);
+    case ConeColor::Blue: return blue;
+    case ConeColor::Yellow: return yellow;
+    case ConeColor::SmallOrange: return small_orange;
+    case ConeColor::BigOrange: return big_orange;
+    default: return other;
   }
 }
 
@@ -143,31 +151,209 @@ json pose(double x, double y, double z, double yaw) { return {{"position", posit
 
 json rgba(double r, double g, double b, double a) { return {{"r", r}, {"g", g}, {"b", b}, {"a", a}}; }
 
-json transform(TimeNs at, const char* parent, const char* child, double x, double y, double z, double yaw,
-               double pitch) {
-  return {{"timestamp", stamp(at)},
-          {"parent_frame_id", parent},
-          {"child_frame_id", child},
-          {"translation", position(x, y, z)},
-          {"rotation", rotation(yaw, pitch)}};
+// ------------------------------------------------------------ JSON text
+
+JsonWriter::JsonWriter(std::string& out) : out_(out) { out_.clear(); }
+
+void JsonWriter::separate() {
+  if (comma_) out_ += ',';
+  comma_ = false;
 }
 
-json pose_in_frame(TimeNs at, const char* frame, double x, double y, double yaw) {
-  return {{"timestamp", stamp(at)}, {"frame_id", frame}, {"pose", pose(x, y, 0.0, yaw)}};
+JsonWriter& JsonWriter::begin_object() {
+  separate();
+  out_ += '{';
+  return *this;
 }
 
-json cones_update(const std::vector<Cone>& cones, TimeNs at, const char* id) {
-  json cylinders = json::array();
+JsonWriter& JsonWriter::end_object() {
+  out_ += '}';
+  comma_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::begin_array() {
+  separate();
+  out_ += '[';
+  return *this;
+}
+
+JsonWriter& JsonWriter::end_array() {
+  out_ += ']';
+  comma_ = true;
+  return *this;
+}
+
+JsonWriter& JsonWriter::key(const char* k) {
+  string(k);
+  out_ += ':';
+  comma_ = false;
+  return *this;
+}
+
+JsonWriter& JsonWriter::number(double v) {
+  separate();
+  comma_ = true;
+  if (!std::isfinite(v)) {
+    out_ += "null";
+    return *this;
+  }
+  if (v == 0.0) {
+    out_ += std::signbit(v) ? "-0.0" : "0.0";
+    return *this;
+  }
+  // the shortest digits that read back, d.ddde[+-]x, then laid out as
+  // nlohmann's format_buffer lays out its digits (k of them, the decimal
+  // point n places in): whole numbers to 1e15 with ".0", fractions down to
+  // 1e-5 without an exponent, the rest d.ddde+XX
+  char sci[32];
+  const std::to_chars_result r = std::to_chars(sci, sci + sizeof sci, v, std::chars_format::scientific);
+  const char* e = std::find(sci, r.ptr, 'e');
+  if (sci[0] == '-') out_ += '-';
+  char digits[24];
+  int k = 0;
+  for (const char* c = sci[0] == '-' ? sci + 1 : sci; c < e; ++c) {
+    if (*c != '.') digits[k++] = *c;
+  }
+  int exponent = 0;
+  std::from_chars(e + 1 + (e[1] == '+'), r.ptr, exponent);
+  const int n = exponent + 1;
+  constexpr int kMinExp = -4, kMaxExp = 15;  // std::numeric_limits<double>::digits10
+  if (k <= n && n <= kMaxExp) {
+    out_.append(digits, static_cast<std::size_t>(k)).append(static_cast<std::size_t>(n - k), '0') += ".0";
+  } else if (0 < n && n <= kMaxExp) {
+    out_.append(digits, static_cast<std::size_t>(n)) += '.';
+    out_.append(digits + n, static_cast<std::size_t>(k - n));
+  } else if (kMinExp < n && n <= 0) {
+    out_.append("0.").append(static_cast<std::size_t>(-n), '0').append(digits, static_cast<std::size_t>(k));
+  } else {
+    out_ += digits[0];
+    if (k > 1) (out_ += '.').append(digits + 1, static_cast<std::size_t>(k - 1));
+    // at least two digits of exponent, as printf's %g
+    char x[16];
+    std::snprintf(x, sizeof x, "e%c%02d", n - 1 < 0 ? '-' : '+', std::abs(n - 1));
+    out_ += x;
+  }
+  return *this;
+}
+
+JsonWriter& JsonWriter::integer(std::int64_t v) {
+  separate();
+  comma_ = true;
+  char buf[24];
+  out_.append(buf, static_cast<std::size_t>(std::to_chars(buf, buf + sizeof buf, v).ptr - buf));
+  return *this;
+}
+
+JsonWriter& JsonWriter::boolean(bool v) {
+  separate();
+  comma_ = true;
+  out_ += v ? "true" : "false";
+  return *this;
+}
+
+JsonWriter& JsonWriter::string(const char* s) {
+  separate();
+  comma_ = true;
+  out_ += '"';
+  // escaped as dump() escapes: the two-character forms, else \u00XX below a space
+  for (; *s; ++s) {
+    const auto c = static_cast<unsigned char>(*s);
+    switch (c) {
+      case '"': out_ += "\\\""; break;
+      case '\\': out_ += "\\\\"; break;
+      case '\b': out_ += "\\b"; break;
+      case '\f': out_ += "\\f"; break;
+      case '\n': out_ += "\\n"; break;
+      case '\r': out_ += "\\r"; break;
+      case '\t': out_ += "\\t"; break;
+      default:
+        if (c < 0x20) {
+          char u[8];
+          std::snprintf(u, sizeof u, "\\u%04x", static_cast<unsigned>(c));
+          out_ += u;
+        } else {
+          out_ += static_cast<char>(c);
+        }
+    }
+  }
+  out_ += '"';
+  return *this;
+}
+
+namespace {
+
+// the values above as text (keys in dump()'s order)
+void put_stamp(JsonWriter& w, TimeNs t) {
+  const TimeNs sec = t >= 0 ? t / 1000000000 : -((-t + 999999999) / 1000000000);
+  w.begin_object().key("nsec").integer(t - sec * 1000000000).key("sec").integer(sec).end_object();
+}
+void put_xyz(JsonWriter& w, double x, double y, double z) {
+  w.begin_object().key("x").number(x).key("y").number(y).key("z").number(z).end_object();
+}
+void put_rotation(JsonWriter& w, double yaw, double pitch) {
+  const double cy = std::cos(0.5 * yaw), sy = std::sin(0.5 * yaw), cp = std::cos(0.5 * pitch),
+               sp = std::sin(0.5 * pitch);
+  w.begin_object().key("w").number(cy * cp).key("x").number(-sy * sp).key("y").number(cy * sp);
+  w.key("z").number(sy * cp).end_object();
+}
+void put_pose(JsonWriter& w, double x, double y, double z, double yaw) {
+  w.begin_object().key("orientation");
+  put_rotation(w, yaw, 0.0);
+  w.key("position");
+  put_xyz(w, x, y, z);
+  w.end_object();
+}
+void put_rgba(JsonWriter& w, double r, double g, double b, double a) {
+  w.begin_object().key("a").number(a).key("b").number(b).key("g").number(g).key("r").number(r).end_object();
+}
+
+}  // namespace
+
+void transform(TimeNs at, const char* parent, const char* child, double x, double y, double z, double yaw,
+               double pitch, std::string& out) {
+  JsonWriter w(out);
+  w.begin_object().key("child_frame_id").string(child).key("parent_frame_id").string(parent).key("rotation");
+  put_rotation(w, yaw, pitch);
+  w.key("timestamp");
+  put_stamp(w, at);
+  w.key("translation");
+  put_xyz(w, x, y, z);
+  w.end_object();
+}
+
+void pose_in_frame(TimeNs at, const char* frame, double x, double y, double yaw, std::string& out) {
+  JsonWriter w(out);
+  w.begin_object().key("frame_id").string(frame).key("pose");
+  put_pose(w, x, y, 0.0, yaw);
+  w.key("timestamp");
+  put_stamp(w, at);
+  w.end_object();
+}
+
+void cones_update(const std::vector<Cone>& cones, TimeNs at, const char* id, std::string& out) {
+  JsonWriter w(out);
+  w.begin_object().key("deletions").begin_array().end_array().key("entities").begin_array();
+  // the entity (as entity() has it): its cylinders, one a cone
+  w.begin_object().key("cylinders").begin_array();
   for (const Cone& c : cones) {
     const bool big = c.color == ConeColor::BigOrange;
-    const double h = big ? 0.505 : 0.325, w = big ? 0.285 : 0.228;
-    cylinders.push_back({{"pose", pose(c.position.x, c.position.y, 0.5 * h, 0.0)},
-                         {"size", position(w, w, h)},
-                         {"bottom_scale", 1.0},
-                         {"top_scale", 0.2},
-                         {"color", cone_color(c.color)}});
+    const double h = big ? 0.505 : 0.325, wd = big ? 0.285 : 0.228;
+    w.begin_object().key("bottom_scale").number(1.0).key("color");
+    const double* rgb = cone_rgb(c.color);
+    put_rgba(w, rgb[0], rgb[1], rgb[2], 1.0);
+    w.key("pose");
+    put_pose(w, c.position.x, c.position.y, 0.5 * h, 0.0);
+    w.key("size");
+    put_xyz(w, wd, wd, h);
+    w.key("top_scale").number(0.2).end_object();
   }
-  return entity(at, id, cylinders, json::array());
+  w.end_array().key("frame_id").string("map").key("frame_locked").boolean(false).key("id").string(id);
+  w.key("lifetime");
+  put_stamp(w, 0);
+  w.key("lines").begin_array().end_array().key("timestamp");
+  put_stamp(w, at);
+  w.end_object().end_array().end_object();
 }
 
 json line_update(const std::vector<Vec2>& points, bool closed, TimeNs at, const char* id) {

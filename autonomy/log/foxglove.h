@@ -39,14 +39,42 @@ json position(double x, double y, double z);
 json rotation(double yaw, double pitch = 0.0);
 json pose(double x, double y, double z, double yaw);
 json rgba(double r, double g, double b, double a = 1.0);
+
+// JSON text written straight into a string (replaced; its storage kept),
+// the text json::dump() gives for the same value: numbers in its form (the
+// shortest that reads back, "1.0" for a whole one, an exponent outside
+// 1e-5 .. 1e15), strings escaped as it does. The caller writes each
+// object's keys in dump()'s order (sorted: nlohmann's objects are
+// std::maps). For the messages logged every cycle: no tree of maps to
+// build, walk and free.
+class JsonWriter {
+ public:
+  explicit JsonWriter(std::string& out);
+  JsonWriter& begin_object();
+  JsonWriter& end_object();
+  JsonWriter& begin_array();
+  JsonWriter& end_array();
+  JsonWriter& key(const char* k);
+  JsonWriter& number(double v);  // NaN and infinities as null, as dump()
+  JsonWriter& integer(std::int64_t v);
+  JsonWriter& boolean(bool v);
+  JsonWriter& string(const char* s);
+
+ private:
+  void separate();  // the comma before a value or key that follows another
+  std::string& out_;
+  bool comma_ = false;
+};
+
+// the messages logged every cycle, as their JSON text into `out` (replaced):
 // foxglove.FrameTransform
-json transform(TimeNs at, const char* parent, const char* child, double x, double y, double z, double yaw,
-               double pitch = 0.0);
+void transform(TimeNs at, const char* parent, const char* child, double x, double y, double z, double yaw,
+               double pitch, std::string& out);
 // foxglove.PoseInFrame
-json pose_in_frame(TimeNs at, const char* frame, double x, double y, double yaw);
+void pose_in_frame(TimeNs at, const char* frame, double x, double y, double yaw, std::string& out);
 // foxglove.SceneUpdate: the cones as one entity `id` of cylinders (tapered:
 // a cone) in the map frame, coloured as they are
-json cones_update(const std::vector<Cone>& cones, TimeNs at, const char* id);
+void cones_update(const std::vector<Cone>& cones, TimeNs at, const char* id, std::string& out);
 // foxglove.SceneUpdate: a line strip `id` through the points (z = 2 cm), closed if asked
 json line_update(const std::vector<Vec2>& points, bool closed, TimeNs at, const char* id);
 // the two messages with a `bytes` field, as their JSON text into `out`

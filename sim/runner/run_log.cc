@@ -61,14 +61,16 @@ void RunLog::observe(const SimModel& model, SimState& s) {
   // what was true: the pose at the log rate, the cones once a second
   if (s.k % log_every_ == 0) {
     const Pose2 truth = vehicle::base_pose(model.scenario.vehicle, s.car);
-    log_->write(truth_pose_, at, fg::pose_in_frame(at, "map", truth.x, truth.y, truth.yaw).dump());
+    fg::pose_in_frame(at, "map", truth.x, truth.y, truth.yaw, text_);
+    log_->write(truth_pose_, at, text_);
   }
   if (at >= next_truth_cones_) {
     next_truth_cones_ = at + kNsPerSecond;
-    std::vector<Cone> truth(static_cast<std::size_t>(s.cones.cone_count()));
+    truth_cones_of_.resize(static_cast<std::size_t>(s.cones.cone_count()));
     for (int i = 0; i < s.cones.cone_count(); ++i)
-      truth[static_cast<std::size_t>(i)] = {s.cones.cone_position(i), s.cones.cone(i).color};
-    log_->write(truth_cones_, at, fg::cones_update(truth, at, "truth_cones").dump());
+      truth_cones_of_[static_cast<std::size_t>(i)] = {s.cones.cone_position(i), s.cones.cone(i).color};
+    fg::cones_update(truth_cones_of_, at, "truth_cones", text_);
+    log_->write(truth_cones_, at, text_);
   }
 }
 

@@ -50,6 +50,8 @@ class RunLog final : public Observer, public WireTap {
   TimeNs next_truth_cones_ = 0;
   TimeNs last_image_ = -1;  // the camera frame last logged
   int log_every_ = 10;  // physics steps between true poses
+  std::vector<Cone> truth_cones_of_;  // the cones as they stand, kept for the next
+  std::string text_;                  // a message's JSON text, kept for the next
 };
 
 }  // namespace paddock::runner
