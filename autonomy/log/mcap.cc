@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <future>
 #include <set>
 #include <utility>
 
@@ -667,15 +668,41 @@ struct McapWriter::Impl {
   bool chunk_has_messages = false;
   std::vector<std::vector<std::uint64_t>> chunk_index;  // per channel id - 1: log_time, offset, ...
   std::vector<std::uint16_t> chunk_channels;            // channels with messages in the open chunk
-  std::vector<std::uint8_t> compressed;
   ZSTD_CCtx* cctx = nullptr;
+
+  // a full chunk, sealed: its records, its Message Index records (built:
+  // they hold no file offset) and times; compressed by `compressing` (on
+  // its own thread with options.background), written by write_sealed()
+  struct Sealed {
+    std::vector<std::uint8_t> records, compressed, indexes;
+    std::vector<std::pair<std::uint16_t, std::size_t>> index_at;  // channel, its record's start in indexes
+    std::uint64_t start = 0, end = 0;
+    bool has_messages = false;
+    std::uint32_t crc = 0;          // of the records
+    std::size_t payload_size = 0;   // the compressed bytes (the records' size when uncompressed)
+  };
+  Sealed sealed;
+  std::future<void> compressing;  // valid: `sealed` is waiting to be written
 
   mutable Statistics stats;
   std::vector<ChunkIndex> chunk_indexes;
   std::vector<MetadataIndex> metadata_indexes;
   std::vector<AttachmentIndex> attachment_indexes;
 
-  ~Impl() { ZSTD_freeCCtx(cctx); }
+  ~Impl() {
+    if (compressing.valid()) compressing.wait();  // the thread uses cctx
+    ZSTD_freeCCtx(cctx);
+  }
+
+  // compresses `sealed` (on the compressing thread, or deferred to write_sealed())
+  void compress_sealed();
+  // the open chunk into `sealed` (the one before it written first), its
+  // compression started; the chunk starts over empty (on the storage the
+  // last sealed one had)
+  void seal_chunk();
+  // the sealed chunk, once compressed, into the file: the Chunk record and
+  // its Message Index records (nothing when none is sealed)
+  void write_sealed();
 
   // bytes to the sink, counted and into the running CRC; a failed write breaks the writer
   void emit(const std::uint8_t* p, std::size_t n) {
@@ -718,7 +745,16 @@ McapWriter::McapWriter(std::unique_ptr<ByteSink> sink, McapWriterOptions options
   w.emit_record();
 }
 
-McapWriter::~McapWriter() = default;
+McapWriter::~McapWriter() {
+  // unclosed: a chunk still being compressed is written as it would have
+  // been without the thread (the .tmp keeps every whole chunk), best effort
+  Impl& w = *impl_;
+  if (w.closed || w.broken) return;
+  try {
+    w.write_sealed();
+  } catch (...) {
+  }
+}
 
 std::uint16_t McapWriter::add_schema(const std::string& name, const std::string& encoding, const std::string& data) {
   return add_schema(name, encoding, std::vector<std::uint8_t>(data.begin(), data.end()));
@@ -728,6 +764,7 @@ std::uint16_t McapWriter::add_schema(const std::string& name, const std::string&
                                      const std::vector<std::uint8_t>& data) {
   Impl& w = *impl_;
   w.check_open();
+  w.write_sealed();  // a chunk still being compressed comes first
   if (w.schemas.size() >= 0xFFFFu) throw std::invalid_argument("mcap: more than 65535 schemas");
   Schema s;
   s.id = static_cast<std::uint16_t>(w.schemas.size() + 1);
@@ -751,6 +788,7 @@ std::uint16_t McapWriter::add_channel(std::uint16_t schema_id, const std::string
                                       const std::string& message_encoding, const KeyValues& metadata) {
   Impl& w = *impl_;
   w.check_open();
+  w.write_sealed();  // a chunk still being compressed comes first
   if (schema_id > w.schemas.size()) throw std::invalid_argument("mcap: unknown schema id " + std::to_string(schema_id));
   if (w.channels.size() >= 0xFFFFu) throw std::invalid_argument("mcap: more than 65535 channels");
   Channel c;
@@ -828,70 +866,103 @@ void McapWriter::write(std::uint16_t channel_id, std::uint32_t sequence, std::ui
   }
   ++s.message_count;
   ++w.channel_counts[channel_id - 1u];
-  if (w.chunk.size() >= w.opt.chunk_size) flush_chunk();
+  // full: compressed beside the next one (written at the next record)
+  if (w.chunk.size() >= w.opt.chunk_size) w.seal_chunk();
 }
 
 void McapWriter::flush_chunk() {
   Impl& w = *impl_;
   w.check_open();
-  if (w.chunk.empty()) return;
-  // "Chunk (op=0x06)": the records' CRC, then compressed (or not)
-  const std::uint32_t uncompressed_crc = crc32(w.chunk.data(), w.chunk.size());
-  const std::uint8_t* payload = w.chunk.data();
-  std::size_t payload_size = w.chunk.size();
-  if (w.opt.compression == Compression::Zstd) {
-    w.compressed.resize(ZSTD_compressBound(w.chunk.size()));
-    const std::size_t r = ZSTD_compressCCtx(w.cctx, w.compressed.data(), w.compressed.size(), w.chunk.data(),
-                                            w.chunk.size(), w.opt.zstd_level);
+  if (!w.chunk.empty()) w.seal_chunk();
+  w.write_sealed();
+}
+
+// "Chunk (op=0x06)": the records' CRC, then compressed (or not). It
+// touches nothing of the writer's but `sealed` and the compression context.
+void McapWriter::Impl::compress_sealed() {
+  Sealed& s = sealed;
+  s.crc = crc32(s.records.data(), s.records.size());
+  s.payload_size = s.records.size();
+  if (opt.compression == Compression::Zstd) {
+    s.compressed.resize(ZSTD_compressBound(s.records.size()));
+    const std::size_t r = ZSTD_compressCCtx(cctx, s.compressed.data(), s.compressed.size(), s.records.data(),
+                                            s.records.size(), opt.zstd_level);
     if (ZSTD_isError(r)) throw std::runtime_error(std::string("mcap: zstd: ") + ZSTD_getErrorName(r));
-    payload = w.compressed.data();
-    payload_size = r;
+    s.payload_size = r;
   }
-  ChunkIndex ci;
-  ci.message_start_time = w.chunk_has_messages ? w.chunk_start : 0;
-  ci.message_end_time = w.chunk_has_messages ? w.chunk_end : 0;
-  ci.chunk_start_offset = w.offset;
-  ci.compression = compression_name(w.opt.compression);
-  ci.compressed_size = payload_size;
-  ci.uncompressed_size = w.chunk.size();
-  Out o{w.record};
-  o.u8(static_cast<std::uint8_t>(Op::Chunk));
-  o.u64(8 + 8 + 8 + 4 + 4 + ci.compression.size() + 8 + payload_size);
-  o.u64(ci.message_start_time);
-  o.u64(ci.message_end_time);
-  o.u64(ci.uncompressed_size);
-  o.u32(uncompressed_crc);
-  o.str(ci.compression);
-  o.u64(payload_size);
-  w.emit_record();
-  w.emit(payload, payload_size);
-  ci.chunk_length = w.offset - ci.chunk_start_offset;
+}
+
+void McapWriter::Impl::seal_chunk() {
+  write_sealed();
+  Sealed& s = sealed;
+  std::swap(s.records, chunk);
+  chunk.clear();
+  s.start = chunk_has_messages ? chunk_start : 0;
+  s.end = chunk_has_messages ? chunk_end : 0;
+  s.has_messages = chunk_has_messages;
   // "Message Index (op=0x07)": one per channel in the chunk, by channel id, entries in file order
-  const std::uint64_t index_start = w.offset;
-  std::sort(w.chunk_channels.begin(), w.chunk_channels.end());
-  for (const std::uint16_t ch : w.chunk_channels) {
-    auto& index = w.chunk_index[ch - 1u];
-    ci.message_index_offsets[ch] = w.offset;
+  s.indexes.clear();
+  s.index_at.clear();
+  Out o{s.indexes};
+  std::sort(chunk_channels.begin(), chunk_channels.end());
+  for (const std::uint16_t ch : chunk_channels) {
+    auto& index = chunk_index[ch - 1u];
+    s.index_at.emplace_back(ch, s.indexes.size());
     const std::size_t at = o.begin(Op::MessageIndex);
     o.u16(ch);
     o.u32(Out::length32(8 * index.size(), "a message index"));
     for (const std::uint64_t v : index) o.u64(v);
     o.end(at);
-    w.emit_record();
     index.clear();
   }
-  ci.message_index_length = w.offset - index_start;
-  w.chunk_indexes.push_back(std::move(ci));
   // the next chunk starts empty
-  w.chunk.clear();
-  w.chunk_channels.clear();
-  w.chunk_has_messages = false;
-  ++w.stats.chunk_count;
+  chunk_channels.clear();
+  chunk_has_messages = false;
+  ++stats.chunk_count;
+  compressing = std::async(opt.background ? std::launch::async : std::launch::deferred, &Impl::compress_sealed, this);
+}
+
+void McapWriter::Impl::write_sealed() {
+  if (!compressing.valid()) return;
+  try {
+    compressing.get();
+  } catch (...) {
+    broken = true;  // the chunk's messages cannot be written: the file stays unfinished
+    throw;
+  }
+  const Sealed& s = sealed;
+  const std::uint8_t* payload = opt.compression == Compression::Zstd ? s.compressed.data() : s.records.data();
+  ChunkIndex ci;
+  ci.message_start_time = s.start;
+  ci.message_end_time = s.end;
+  ci.chunk_start_offset = offset;
+  ci.compression = compression_name(opt.compression);
+  ci.compressed_size = s.payload_size;
+  ci.uncompressed_size = s.records.size();
+  Out o{record};
+  o.u8(static_cast<std::uint8_t>(Op::Chunk));
+  o.u64(8 + 8 + 8 + 4 + 4 + ci.compression.size() + 8 + s.payload_size);
+  o.u64(ci.message_start_time);
+  o.u64(ci.message_end_time);
+  o.u64(ci.uncompressed_size);
+  o.u32(s.crc);
+  o.str(ci.compression);
+  o.u64(s.payload_size);
+  emit_record();
+  emit(payload, s.payload_size);
+  ci.chunk_length = offset - ci.chunk_start_offset;
+  // its Message Index records, where they land
+  const std::uint64_t index_start = offset;
+  for (const auto& [ch, at] : s.index_at) ci.message_index_offsets[ch] = index_start + at;
+  emit(s.indexes.data(), s.indexes.size());
+  ci.message_index_length = offset - index_start;
+  chunk_indexes.push_back(std::move(ci));
 }
 
 void McapWriter::write_metadata(const std::string& name, const KeyValues& metadata) {
   Impl& w = *impl_;
   w.check_open();
+  w.write_sealed();  // a chunk still being compressed comes first
   // "Metadata (op=0x0C)" in the data section, its index for the summary
   MetadataIndex mi;
   mi.offset = w.offset;
@@ -910,6 +981,7 @@ void McapWriter::write_metadata(const std::string& name, const KeyValues& metada
 void McapWriter::write_attachment(const Attachment& a) {
   Impl& w = *impl_;
   w.check_open();
+  w.write_sealed();  // a chunk still being compressed comes first
   // "Attachment (op=0x09)": its crc covers the fields before it
   AttachmentIndex ai;
   ai.offset = w.offset;

@@ -281,9 +281,14 @@ struct McapWriterOptions {
   Compression compression = Compression::Zstd;
   int zstd_level = 1;                    // libzstd's level (1: fastest of the usual ones)
   std::uint64_t chunk_size = 4u << 20;   // a chunk ends once its uncompressed records reach this
+  // a full chunk is compressed (and its CRC taken) on a thread of its own
+  // while the next one fills, and written at the next record: the file's
+  // bytes are the same either way; false: all on the caller's thread
+  bool background = true;
 };
 
-// writes one MCAP file into a sink. Not thread-safe. Every method but the
+// writes one MCAP file into a sink. Not thread-safe (its one compressing
+// thread, McapWriterOptions::background, is its own business). Every method but the
 // destructor throws: std::invalid_argument (an unknown id, too many schemas
 // or channels), std::logic_error (used after close, or after the sink
 // failed: the file then stays unfinished), or what the sink throws.
@@ -293,6 +298,7 @@ class McapWriter {
   McapWriter(std::unique_ptr<ByteSink> sink, McapWriterOptions options = {});
   // without close() the file is left unfinished: the sink is destroyed
   // unclosed (a FileSink leaves only its .tmp) and the open chunk is lost
+  // (a full one still being compressed is written first)
   ~McapWriter();
   McapWriter(const McapWriter&) = delete;
   McapWriter& operator=(const McapWriter&) = delete;
@@ -315,7 +321,8 @@ class McapWriter {
   void write_metadata(const std::string& name, const KeyValues& metadata);
   // an Attachment record in the data section, with its CRC (indexed in the summary)
   void write_attachment(const Attachment& attachment);
-  // writes the open chunk now (nothing when it is empty)
+  // writes the open chunk now (nothing when it is empty), and one still
+  // being compressed before it
   void flush_chunk();
   // the open chunk, Data End, the summary, the Footer and the Magic; then
   // the sink's close(). A second call does nothing (after a sink failure it

@@ -686,6 +686,37 @@ TEST_P(Compressions, ATruncatedFileIsAnErrorAndStreamsUpToItsLastWholeChunk) {
   EXPECT_GT(cuts, 100u);
 }
 
+// the compressing thread changes nothing in the file: the same bytes as
+// compressing on the caller's thread, with records written between the
+// chunks (a schema, a channel, metadata, an attachment) in their places;
+// unclosed, the .tmp holds every whole chunk either way
+TEST_P(Compressions, ABackgroundCompressionWritesTheSameBytes) {
+  const std::vector<Written> run = make_run(0.4, 11);
+  auto write = [&](bool background, bool close, Bytes& bytes) {
+    McapWriterOptions o = options_for(GetParam(), 64 << 10);
+    o.background = background;
+    McapWriter w(std::make_unique<MemorySink>(bytes), o);
+    for (const TopicSpec& t : kTopics) w.add_channel(0, t.topic, t.encoding);
+    for (std::size_t i = 0; i < run.size(); ++i) {
+      const Written& m = run[i];
+      w.write(m.channel, m.sequence, m.log_time, m.publish_time, m.data.data(), m.data.size());
+      if (i == run.size() / 4) w.write_metadata("between", {{"i", std::to_string(i)}});
+      if (i == run.size() / 3) w.write_attachment({1, 2, "a.txt", "text/plain", Bytes(300, 7)});
+      if (i == run.size() / 2) w.add_channel(w.add_schema("late", "jsonschema", "{}"), "/late", "json");
+    }
+    if (close) w.close();
+  };
+  Bytes inline_bytes, background_bytes, unclosed_inline, unclosed_background;
+  write(false, true, inline_bytes);
+  write(true, true, background_bytes);
+  EXPECT_EQ(background_bytes, inline_bytes);
+  EXPECT_GT(open_reader(background_bytes)->chunk_indexes().size(), 5u);
+  write(false, false, unclosed_inline);
+  write(true, false, unclosed_background);
+  EXPECT_EQ(unclosed_background, unclosed_inline);
+  EXPECT_GT(unclosed_background.size(), inline_bytes.size() / 2);
+}
+
 TEST_P(Compressions, AFlippedBitInAChunkIsACrcMismatch) {
   const std::vector<Written> run = make_run(0.1, 8, 1500);
   const Bytes bytes = write_file(run, options_for(GetParam(), 16 << 10));
