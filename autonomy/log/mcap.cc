@@ -677,7 +677,6 @@ struct McapWriter::Impl {
     std::vector<std::uint8_t> records, compressed, indexes;
     std::vector<std::pair<std::uint16_t, std::size_t>> index_at;  // channel, its record's start in indexes
     std::uint64_t start = 0, end = 0;
-    bool has_messages = false;
     std::uint32_t crc = 0;          // of the records
     std::size_t payload_size = 0;   // the compressed bytes (the records' size when uncompressed)
   };
@@ -899,7 +898,6 @@ void McapWriter::Impl::seal_chunk() {
   chunk.clear();
   s.start = chunk_has_messages ? chunk_start : 0;
   s.end = chunk_has_messages ? chunk_end : 0;
-  s.has_messages = chunk_has_messages;
   // "Message Index (op=0x07)": one per channel in the chunk, by channel id, entries in file order
   s.indexes.clear();
   s.index_at.clear();
