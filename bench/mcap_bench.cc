@@ -115,11 +115,14 @@ void write_run(McapWriter& w) {
   w.close();
 }
 
-// zstd at `level`, or uncompressed when it is 0
+// zstd at `level`, or uncompressed when it is 0; compressed on the
+// caller's thread (the writer's whole work in the benchmark's thread and
+// its CPU time, which ./paddock bench compare compares)
 McapWriterOptions options(std::int64_t level) {
   McapWriterOptions o;
   o.compression = level > 0 ? Compression::Zstd : Compression::None;
   o.zstd_level = static_cast<int>(level);
+  o.background = false;
   return o;
 }
 
