@@ -782,7 +782,7 @@ void McapWriter::write(std::uint16_t channel_id, std::uint32_t sequence, std::ui
   }
   ++s.message_count;
   ++w.channel_counts[channel_id - 1u];
-  // full: compressed beside the next one (written at the next record)
+  // full: compressed beside the next one (in the file before anything after it)
   if (w.chunk.size() >= w.opt.chunk_size) w.seal_chunk();
 }
 

@@ -289,8 +289,8 @@ TEST(Crc32, MatchesTheStandardCheckValueAndTheBitwiseDefinition) {
   }
   // chained over two pieces: the CRC of the whole
   EXPECT_EQ(crc32(data.data() + 501, data.size() - 501, crc32(data.data(), 501)), ref_crc32(data.data(), data.size()));
-  // every length about the carry-less path's 64-byte start and 16-byte
-  // steps, at every alignment
+  // every short length at every alignment (where an implementation's word
+  // and block steps begin and end)
   for (std::size_t at = 0; at < 16; ++at) {
     for (std::size_t n = 0; n <= 300; ++n) EXPECT_EQ(crc32(data.data() + at, n), ref_crc32(data.data() + at, n)) << at << " " << n;
   }
