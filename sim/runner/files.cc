@@ -1,10 +1,13 @@
 #include "sim/runner/files.h"
 
+#include <elf.h>
 #include <fcntl.h>
+#include <link.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -82,6 +85,48 @@ void write_file_atomic(const std::string& path, const std::string& content) {
     ::fsync(dfd);
     ::close(dfd);
   }
+}
+
+std::string program_build_id() {
+  // the main program is the first object dl_iterate_phdr reports; its
+  // PT_NOTE segments hold the note GNU / NT_GNU_BUILD_ID
+  std::string id;
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, std::size_t, void* out) -> int {
+        for (int i = 0; i < info->dlpi_phnum; ++i) {
+          const ElfW(Phdr)& ph = info->dlpi_phdr[i];
+          if (ph.p_type != PT_NOTE) continue;
+          const char* p = reinterpret_cast<const char*>(info->dlpi_addr + ph.p_vaddr);
+          const char* const end = p + ph.p_memsz;
+          const auto align4 = [](std::size_t n) { return (n + 3) & ~std::size_t{3}; };
+          while (p + sizeof(ElfW(Nhdr)) <= end) {
+            const auto* note = reinterpret_cast<const ElfW(Nhdr)*>(p);
+            const char* name = p + sizeof(ElfW(Nhdr));
+            const unsigned char* desc = reinterpret_cast<const unsigned char*>(name + align4(note->n_namesz));
+            if (reinterpret_cast<const char*>(desc) + note->n_descsz > end) break;
+            if (note->n_type == NT_GNU_BUILD_ID && note->n_namesz == 4 && std::memcmp(name, "GNU", 4) == 0) {
+              static const char kHex[] = "0123456789abcdef";
+              auto& text = *static_cast<std::string*>(out);
+              for (unsigned k = 0; k < note->n_descsz; ++k) {
+                text += kHex[desc[k] >> 4];
+                text += kHex[desc[k] & 15];
+              }
+              return 1;
+            }
+            p = reinterpret_cast<const char*>(desc) + align4(note->n_descsz);
+          }
+        }
+        return 1;  // the main program only
+      },
+      &id);
+  return id;
+}
+
+std::string cache_dir() {
+  if (const char* own = std::getenv("PADDOCK_CACHE_DIR")) return own;
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg) return std::string(xdg) + "/paddock";
+  if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/paddock";
+  return "";
 }
 
 IncompleteMarker::IncompleteMarker(const std::string& dir, const std::string& what) : path_(dir + "/INCOMPLETE") {

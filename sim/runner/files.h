@@ -29,6 +29,17 @@ std::string read_file(const std::string& path, std::uint64_t max_bytes = kMaxInp
 // old file untouched
 void write_file_atomic(const std::string& path, const std::string& content);
 
+// this program's GNU build ID (the linker's hash of the executable, `readelf
+// -n`) as hex; "" when it has none. Two programs with the same ID are the
+// same code, so a result the code alone determines may be kept under it
+std::string program_build_id();
+
+// the folder for results kept between runs (the car's measured envelope):
+// $PADDOCK_CACHE_DIR, else $XDG_CACHE_HOME/paddock, else ~/.cache/paddock;
+// "" (keep nothing) when PADDOCK_CACHE_DIR is set empty or none is known.
+// Anything in it may be deleted at any time
+std::string cache_dir();
+
 // a run's output folder while the run is not done: DIR/INCOMPLETE says so
 // from the start (which checks the folder can be written, before the work)
 // until done() has removed it, after every result is in place. A run that is

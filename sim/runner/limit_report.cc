@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <exception>
 #include <future>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -16,7 +18,9 @@
 #include "autonomy/planning/reference.h"
 #include "autonomy/planning/spline.h"
 #include "sim/runner/files.h"
+#include "sim/runner/ini.h"
 #include "sim/runner/plots.h"
+#include "sim/runner/schema.h"
 
 namespace paddock::runner {
 
@@ -80,6 +84,92 @@ planning::VelocityProfileParams car_envelope(const vehicle::VehicleParams& car, 
   return e;
 }
 
+namespace {
+
+// FNV-1a, 64 bits: a name for a cache entry (not a defence against anyone)
+std::string hash_hex(const std::string& text) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : text) h = (h ^ c) * 0x100000001b3ULL;
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+// The car's envelope kept on disk between runs: measuring it costs about a
+// second of CPU (~1,000 s of the car driven at 1 kHz), a fifth of a one-lap
+// run on one core, and every run of the same car in the same program
+// measures the same numbers. An entry is the envelope's keys, each number
+// as the shortest text that reads back to the same double, under this
+// program's build ID (other code: another entry) and the car's fingerprint
+// (its every parameter, exactly), hashed into the file's name and into the
+// file: a result the program and the car alone determine, so a run that
+// reads it gives what one that measures gives, bit for bit (tested)
+struct EnvelopeCache {
+  std::string path;      // "" when nothing can be kept (no cache folder or no build ID)
+  std::string build;     // the program's build ID
+  std::string car_hash;  // of the car's fingerprint
+
+  explicit EnvelopeCache(const std::string& car_fingerprint) {
+    const std::string dir = cache_dir();
+    build = program_build_id();
+    if (dir.empty() || build.empty()) return;
+    car_hash = hash_hex("car\n" + car_fingerprint);
+    path = dir + "/car-envelope-" + hash_hex(build + "\n" + car_fingerprint) + ".ini";
+  }
+
+  // the kept envelope, or none when there is none or it is not whole and
+  // valid (a miss measures again and rewrites it)
+  std::optional<planning::VelocityProfileParams> read() const {
+    if (path.empty()) return std::nullopt;
+    try {
+      const std::vector<IniEntry> entries = parse_ini_text(read_file(path, 1 << 20), path, "");
+      planning::VelocityProfileParams e;
+      std::vector<Key> keys = profile_keys(e);
+      bool build_ok = false, car_ok = false;
+      std::size_t set = 0;
+      for (const IniEntry& entry : entries) {
+        if (entry.section == "cache") {
+          if (entry.key == "build") build_ok = entry.value == build;
+          if (entry.key == "car") car_ok = entry.value == car_hash;
+          continue;
+        }
+        if (entry.section != "envelope") return std::nullopt;
+        const auto k = std::find_if(keys.begin(), keys.end(), [&](const Key& key) { return key.name == entry.key; });
+        if (k == keys.end()) return std::nullopt;
+        k->set(entry);
+        ++set;
+      }
+      if (!build_ok || !car_ok || set != keys.size() || !params::validate(e).empty()) return std::nullopt;
+      return e;
+    } catch (const std::exception&) {
+      return std::nullopt;  // unreadable or malformed: measured again
+    }
+  }
+
+  // keeps e (atomically); a folder that cannot be written keeps nothing
+  void write(planning::VelocityProfileParams e) const {
+    if (path.empty()) return;
+    std::string text =
+        "; the g-g-v envelope paddock measured for one car (the limit lap's), kept between runs; safe to delete\n"
+        "[cache]\nbuild = " + build + "\ncar = " + car_hash + "\n[envelope]\n";
+    for (const Key& k : profile_keys(e)) text += k.name + " = " + k.get() + "\n";
+    try {
+      write_file_atomic(path, text);
+    } catch (const UserError&) {
+    }
+  }
+};
+
+}  // namespace
+
+planning::VelocityProfileParams kept_car_envelope(const vehicle::VehicleParams& car) {
+  const EnvelopeCache cache(params::fingerprint(car));
+  if (std::optional<planning::VelocityProfileParams> kept = cache.read()) return *kept;
+  const planning::VelocityProfileParams e = car_envelope(car);
+  cache.write(e);
+  return e;
+}
+
 planning::VelocityProfileParams shared_car_envelope(const vehicle::VehicleParams& car) {
   static std::mutex mutex;
   static std::map<std::string, std::shared_future<planning::VelocityProfileParams>> measured;
@@ -97,7 +187,7 @@ planning::VelocityProfileParams shared_car_envelope(const vehicle::VehicleParams
   }
   if (future.valid()) return future.get();  // measured, or being measured
   try {
-    const planning::VelocityProfileParams e = car_envelope(car);
+    const planning::VelocityProfileParams e = kept_car_envelope(car);
     promise.set_value(e);
     return e;
   } catch (...) {

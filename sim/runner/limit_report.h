@@ -49,11 +49,15 @@ LimitLines limit_lines(const world::TrackModel& track, const planning::VelocityP
 
 // the car's envelope as the QSS uses it: measure_ggv, then ggv_envelope
 planning::VelocityProfileParams car_envelope(const vehicle::VehicleParams& car, GgvMeasurement* measured = nullptr);
-// the same, measured once per process and car (params::fingerprint of its
+// the same, kept on disk between runs (cache_dir(), files.h): read when this
+// program measured this car before (the same build ID and every parameter
+// the same), else measured and kept. The same numbers either way
+planning::VelocityProfileParams kept_car_envelope(const vehicle::VehicleParams& car);
+// the same, once per process and car (params::fingerprint of its
 // parameters): the points of a sweep in one process share their car's
-// (~2 s of CPU each on the default car). Thread-safe; a second caller for
-// a car being measured waits for that measurement; an exception is
-// rethrown to every caller
+// (~1 s of CPU each on the default car when not kept on disk). Thread-safe;
+// a second caller for a car being measured waits for that measurement; an
+// exception is rethrown to every caller
 planning::VelocityProfileParams shared_car_envelope(const vehicle::VehicleParams& car);
 
 struct LimitReport {

@@ -180,6 +180,12 @@ std::vector<Key> scenario_keys(Scenario& s) {
   return std::move(c.keys);
 }
 
+std::vector<Key> profile_keys(planning::VelocityProfileParams& p) {
+  KeyCollector c;
+  p.visit(c);
+  return std::move(c.keys);
+}
+
 std::vector<SectionDoc> scenario_sections() {
   Scenario s;
   KeyCollector c;

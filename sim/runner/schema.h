@@ -13,6 +13,10 @@
 #include "autonomy/common/params.h"
 #include "sim/runner/ini.h"
 
+namespace paddock::planning {
+struct VelocityProfileParams;
+}
+
 namespace paddock::runner {
 
 struct Scenario;
@@ -44,6 +48,9 @@ struct SectionDoc {
 
 // every key of s, bound to s's fields, in declaration order; s must outlive them
 std::vector<Key> scenario_keys(Scenario& s);
+// the same for a velocity profile's own keys (section ""): the car's measured
+// envelope kept between runs (limit_report.cc)
+std::vector<Key> profile_keys(planning::VelocityProfileParams& p);
 // every section (with its meaning), in declaration order
 std::vector<SectionDoc> scenario_sections();
 

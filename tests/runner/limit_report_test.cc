@@ -8,9 +8,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -141,6 +145,85 @@ TEST(SharedCarEnvelope, IsTheCarsOwnMeasurementForEveryCaller) {
   EXPECT_NE(heavy, own);
   EXPECT_EQ(params::fingerprint(shared_car_envelope(heavier)), heavy);
   EXPECT_EQ(params::fingerprint(shared_car_envelope(s.vehicle)), own);
+}
+
+// PADDOCK_CACHE_DIR for one test, restored after it
+class CacheDirFor {
+ public:
+  explicit CacheDirFor(const std::string& dir) {
+    if (const char* old = std::getenv("PADDOCK_CACHE_DIR")) old_ = old;
+    setenv("PADDOCK_CACHE_DIR", dir.c_str(), 1);
+  }
+  ~CacheDirFor() {
+    if (old_) setenv("PADDOCK_CACHE_DIR", old_->c_str(), 1);
+    else unsetenv("PADDOCK_CACHE_DIR");
+  }
+
+ private:
+  std::optional<std::string> old_;
+};
+
+std::vector<fs::path> files_in(const std::string& dir) {
+  std::vector<fs::path> out;
+  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path());
+  return out;
+}
+
+// the car's envelope kept between runs: what a run reads back is what a
+// measurement gives, bit for bit; it is read (not measured again) while
+// the file is whole, and measured again and rewritten when the file is of
+// another build or broken
+TEST(KeptCarEnvelope, ReadsBackTheMeasurementAndMeasuresAgainWhenTheFileIsNotWhole) {
+  const std::string dir = scratch("cache");
+  fs::remove_all(dir);
+  const CacheDirFor env(dir);
+  const Scenario s = load_scenario(kRoot + "/scenarios/fsg_2023_trackdrive.ini");
+  const std::string own = params::fingerprint(car_envelope(s.vehicle));
+
+  EXPECT_EQ(params::fingerprint(kept_car_envelope(s.vehicle)), own);  // measured and kept
+  const std::vector<fs::path> kept = files_in(dir);
+  ASSERT_EQ(kept.size(), 1u);
+  const std::string text = read_file(kept[0].string());
+  EXPECT_THAT(text, HasSubstr("build = " + program_build_id() + "\n"));
+
+  // read back: a value changed in the file (within its bounds) is what a run gets
+  const auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto at = t.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) t.replace(at, from.size(), to);
+    return t;
+  };
+  write_file_atomic(kept[0].string(), with("\nax_max = 8\n", "\nax_max = 7.5\n"));
+  EXPECT_EQ(kept_car_envelope(s.vehicle).ax_max, 7.5);
+
+  // another build's entry, a truncated file, a value out of its bounds:
+  // measured again, and the file rewritten as it was
+  for (const std::string& broken : {with("build = ", "build = 0"), text.substr(0, text.size() / 2),
+                                    with("\nax_max = 8\n", "\nax_max = -1\n")}) {
+    write_file_atomic(kept[0].string(), broken);
+    EXPECT_EQ(params::fingerprint(kept_car_envelope(s.vehicle)), own);
+    EXPECT_EQ(read_file(kept[0].string()), text);
+  }
+  EXPECT_EQ(files_in(dir).size(), 1u);  // no temporary file left
+}
+
+TEST(CacheDir, FromTheEnvironmentAndOffWhenSetEmpty) {
+  {
+    const CacheDirFor env("/some/where");
+    EXPECT_EQ(cache_dir(), "/some/where");
+  }
+  const CacheDirFor off("");
+  EXPECT_EQ(cache_dir(), "");
+}
+
+// the build ID is the one the linker wrote (readelf's reading of this program)
+TEST(ProgramBuildId, IsTheLinkersNote) {
+  const std::string id = program_build_id();
+  ASSERT_EQ(id.size(), 40u) << id;  // the linker's default: SHA-1
+  const std::string out = scratch("readelf.txt");
+  ASSERT_EQ(std::system(("readelf -n /proc/" + std::to_string(::getpid()) + "/exe > " + out).c_str()), 0);
+  EXPECT_THAT(read_file(out), HasSubstr("Build ID: " + id + "\n"));
 }
 
 TEST(GgvEnvelope, NodesFromTheRowsAndTheGripLineUnderTheLock) {
