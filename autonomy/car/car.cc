@@ -99,7 +99,8 @@ struct Car {
   }
   // a camera frame; jpeg: its bytes when the camera sent JPEG (else the log encodes it)
   void camera(TimeNs at, hal::CameraFrame frame, const std::vector<std::uint8_t>& jpeg) {
-    if (log) log->image(at, frame.stamp, jpeg.empty() ? hal::encode_jpeg(frame, kJpegQuality) : jpeg);
+    if (log && jpeg.empty()) log->image(at, frame, kJpegQuality);
+    else if (log) log->image(at, frame.stamp, jpeg);
     node.camera_frame(std::move(frame));
   }
   void object(TimeNs at, const std::vector<std::uint8_t>& p) {

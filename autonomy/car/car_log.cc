@@ -1,9 +1,12 @@
 #include "autonomy/car/car_log.h"
 
+#include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <variant>
 
 #include "autonomy/hal/car_can.h"
+#include "autonomy/hal/image.h"
 #include "autonomy/hal/json.h"
 #include "autonomy/log/foxglove.h"
 
@@ -14,11 +17,12 @@ using nlohmann::json;
 
 CarLog::CarLog(const std::string& path, const std::vector<File>& attachments, const log::KeyValues& metadata,
                const std::optional<hal::ouster::SensorInfo>& lidar, const hal::LidarLayout& layout,
-               TimeNs pose_period)
-    : layout_(layout), pose_period_(pose_period) {
+               TimeNs pose_period, bool threaded)
+    : layout_(layout), pose_period_(pose_period), worker_(std::make_unique<SerialWorker>(threaded)) {
   log::McapWriterOptions o;
   o.profile = "";
   o.library = "paddock";
+  o.background = false;  // the chunks are compressed where everything else is: the worker's thread
   try {
     mcap_ = std::make_unique<log::McapWriter>(std::make_unique<log::FileSink>(path), o);
   } catch (const std::exception& e) {
@@ -77,6 +81,7 @@ CarLog::CarLog(const std::string& path, const std::vector<File>& attachments, co
 CarLog::~CarLog() = default;
 
 std::uint16_t CarLog::channel(const std::string& topic, const std::string& schema, const std::string& encoding) {
+  worker_->drain();  // the writer is the caller's for a moment
   // one Schema record per schema, however many channels use it
   std::uint16_t schema_id = 0;
   if (!schema.empty()) {
@@ -89,18 +94,20 @@ std::uint16_t CarLog::channel(const std::string& topic, const std::string& schem
   return id;
 }
 
-void CarLog::write(std::uint16_t ch, TimeNs at, const std::uint8_t* data, std::size_t size) {
+void CarLog::write_now(std::uint16_t ch, TimeNs at, const std::uint8_t* data, std::size_t size) {
   const auto t = static_cast<std::uint64_t>(std::max<TimeNs>(at, 0));
   mcap_->write(ch, sequence_[ch]++, t, t, data, size);
 }
 
-void CarLog::write(std::uint16_t ch, TimeNs at, const std::string& data) {
-  write(ch, at, reinterpret_cast<const std::uint8_t*>(data.data()), data.size());
+void CarLog::write_now(std::uint16_t ch, TimeNs at, const std::string& data) {
+  write_now(ch, at, reinterpret_cast<const std::uint8_t*>(data.data()), data.size());
 }
 
-void CarLog::lidar_packet(TimeNs at, const std::uint8_t* data, std::size_t size) {
-  write(packets_, at, data, size);
-  if (!decoder_) return;
+void CarLog::write(std::uint16_t ch, TimeNs at, const std::string& data) {
+  worker_->post([this, ch, at, data] { write_now(ch, at, data); });
+}
+
+void CarLog::decode(TimeNs at, const std::uint8_t* data, std::size_t size) {
   decoder_->push(data, size);
   // every kPointCloudEvery-th rotation (the decoder scans no other)
   while (std::optional<hal::LidarScan> scan = decoder_->pop()) {
@@ -108,61 +115,67 @@ void CarLog::lidar_packet(TimeNs at, const std::uint8_t* data, std::size_t size)
     xyzi_.clear();
     for (const hal::LidarPoint& p : scan->points) xyzi_.insert(xyzi_.end(), {p.x, p.y, p.z, p.intensity});
     fg::point_cloud(scan->end, "lidar", xyzi_.data(), scan->points.size(), text_);
-    write(points_, at, text_);
+    write_now(points_, at, text_);
   }
+}
+
+void CarLog::lidar_packet(TimeNs at, const std::uint8_t* data, std::size_t size) {
+  worker_->post([this, at, packet = std::vector<std::uint8_t>(data, data + size)] {
+    write_now(packets_, at, packet.data(), packet.size());
+    if (decoder_) decode(at, packet.data(), packet.size());
+  });
 }
 
 void CarLog::can_frame(TimeNs at, bool to_stack, const std::uint8_t* frame) {
-  write(to_stack ? can_rx_ : can_tx_, at, frame, hal::kSocketCanFrameSize);
+  std::array<std::uint8_t, hal::kSocketCanFrameSize> bytes;
+  std::copy(frame, frame + bytes.size(), bytes.begin());
+  worker_->post([this, at, ch = to_stack ? can_rx_ : can_tx_, bytes] { write_now(ch, at, bytes.data(), bytes.size()); });
 }
 
 void CarLog::message(TimeNs at, const hal::SensorMessage& m) {
-  const std::optional<std::string> j = hal::to_json(m);
-  if (!j) return;  // a wire carries it: logged as its bytes
-  const std::uint16_t ch = std::holds_alternative<hal::CameraDetections>(m) ? detections_
-                           : std::holds_alternative<hal::ConeDetections>(m) ? cones_
-                                                                            : state_;
-  write(ch, at, *j);
+  worker_->post([this, at, m] {
+    const std::optional<std::string> j = hal::to_json(m);
+    if (!j) return;  // a wire carries it: logged as its bytes
+    const std::uint16_t ch = std::holds_alternative<hal::CameraDetections>(m) ? detections_
+                             : std::holds_alternative<hal::ConeDetections>(m) ? cones_
+                                                                              : state_;
+    write_now(ch, at, *j);
+  });
 }
 
 void CarLog::image(TimeNs at, TimeNs stamp, const std::vector<std::uint8_t>& jpeg) {
-  fg::compressed_image(stamp, "camera", jpeg.data(), jpeg.size(), "jpeg", text_);
-  write(image_, at, text_);
+  worker_->post([this, at, stamp, jpeg] {
+    fg::compressed_image(stamp, "camera", jpeg.data(), jpeg.size(), "jpeg", text_);
+    write_now(image_, at, text_);
+  });
+}
+
+void CarLog::image(TimeNs at, const hal::CameraFrame& frame, int quality) {
+  worker_->post([this, at, frame, quality] {
+    const std::vector<std::uint8_t> jpeg = hal::encode_jpeg(frame, quality);
+    fg::compressed_image(frame.stamp, "camera", jpeg.data(), jpeg.size(), "jpeg", text_);
+    write_now(image_, at, text_);
+  });
 }
 
 void CarLog::cycle(TimeNs at, const hal::ActuatorCommand& c, const stack::Stack& stack) {
-  if (!mounted_) {
-    // where the LiDAR sits on the car
-    mounted_ = true;
-    fg::transform(at, "base", "lidar", layout_.mount_x, layout_.mount_y, layout_.mount_z, 0.0, layout_.mount_pitch,
-                  text_);
-    write(tf_, at, text_);
-  }
-  // the command (its keys in the order json::dump() sorts them)
-  fg::JsonWriter(text_)
-      .begin_object()
-      .key("as_state").string(hal::to_string(c.as_state))
-      .key("brake").number(c.brake)
-      .key("stamp").integer(c.stamp)
-      .key("steering_angle").number(c.steering_angle)
-      .key("throttle").number(c.throttle)
-      .key("yaw_moment").number(c.yaw_moment)
-      .end_object();
-  write(command_, at, text_);
+  // what is due is decided here, from the stack as it is now; the messages
+  // are made on the log's thread from copies
+  const bool mount = !mounted_;
+  mounted_ = true;
+  std::optional<hal::StateEstimate> pose;
   const std::optional<hal::StateEstimate>& e = stack.estimate();
   if (e && (!next_pose_ || at >= *next_pose_)) {
     next_pose_ = at + pose_period_;
-    fg::pose_in_frame(e->stamp, "map", e->pose.x, e->pose.y, e->pose.yaw, text_);
-    write(pose_, at, text_);
-    fg::transform(e->stamp, "map", "base", e->pose.x, e->pose.y, 0.0, e->pose.yaw, 0.0, text_);
-    write(tf_, at, text_);
+    pose = e;
   }
+  std::optional<std::vector<Cone>> map;
   if (!next_map_ || at >= *next_map_) {
     next_map_ = at + kNsPerSecond;
-    fg::cones_update(stack.cone_map().cones(), at, "stack_map", text_);
-    write(map_, at, text_);
+    map = stack.cone_map().cones();
   }
   // the trajectory when it changed, at most twice a second
+  std::optional<std::vector<Vec2>> path;
   const Trajectory& tr = stack.trajectory();
   const bool changed = tr.points.data() != path_of_ || tr.points.size() != path_points_ || tr.length != path_length_;
   if (changed && (!next_path_ || at >= *next_path_) && !tr.empty()) {
@@ -170,13 +183,46 @@ void CarLog::cycle(TimeNs at, const hal::ActuatorCommand& c, const stack::Stack&
     path_of_ = tr.points.data();
     path_points_ = tr.points.size();
     path_length_ = tr.length;
-    std::vector<Vec2> points;
-    points.reserve(tr.points.size());
-    for (const TrajectoryPoint& p : tr.points) points.push_back(p.position());
-    write(path_, at, fg::line_update(points, tr.closed, at, "path").dump());
+    path.emplace();
+    path->reserve(tr.points.size());
+    for (const TrajectoryPoint& p : tr.points) path->push_back(p.position());
   }
+  worker_->post([this, at, c, mount, pose, map = std::move(map), path = std::move(path), closed = tr.closed] {
+    if (mount) {
+      // where the LiDAR sits on the car
+      fg::transform(at, "base", "lidar", layout_.mount_x, layout_.mount_y, layout_.mount_z, 0.0, layout_.mount_pitch,
+                    text_);
+      write_now(tf_, at, text_);
+    }
+    // the command (its keys in the order json::dump() sorts them)
+    fg::JsonWriter(text_)
+        .begin_object()
+        .key("as_state").string(hal::to_string(c.as_state))
+        .key("brake").number(c.brake)
+        .key("stamp").integer(c.stamp)
+        .key("steering_angle").number(c.steering_angle)
+        .key("throttle").number(c.throttle)
+        .key("yaw_moment").number(c.yaw_moment)
+        .end_object();
+    write_now(command_, at, text_);
+    if (pose) {
+      fg::pose_in_frame(pose->stamp, "map", pose->pose.x, pose->pose.y, pose->pose.yaw, text_);
+      write_now(pose_, at, text_);
+      fg::transform(pose->stamp, "map", "base", pose->pose.x, pose->pose.y, 0.0, pose->pose.yaw, 0.0, text_);
+      write_now(tf_, at, text_);
+    }
+    if (map) {
+      fg::cones_update(*map, at, "stack_map", text_);
+      write_now(map_, at, text_);
+    }
+    if (path) write_now(path_, at, fg::line_update(*path, closed, at, "path").dump());
+  });
+  worker_->flush();  // the cycle's messages to the log's thread: the threads meet once a cycle
 }
 
-void CarLog::close() { mcap_->close(); }
+void CarLog::close() {
+  worker_->drain();
+  mcap_->close();
+}
 
 }  // namespace paddock::car

@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/common/serial_worker.h"
 #include "autonomy/hal/messages.h"
 #include "autonomy/hal/ouster.h"
 #include "autonomy/log/mcap.h"
@@ -49,9 +50,15 @@ class CarLog {
   // writes `path` (through path.tmp, renamed at close()); throws
   // std::runtime_error when it cannot. lidar: the LiDAR's metadata (its
   // packets become clouds) and layout (where it sits on the car);
-  // pose_period: the estimate's poses at most this often
+  // pose_period: the estimate's poses at most this often. threaded: the
+  // encoding (JSON, JPEG, the clouds' decode), compression and writing are
+  // done on a thread of the log's own (a SerialWorker: in the order the
+  // calls came, so the file's bytes are the same either way; a problem it
+  // meets is thrown by a later cycle() or close()); false: on the caller's
   CarLog(const std::string& path, const std::vector<File>& attachments, const log::KeyValues& metadata,
-         const std::optional<hal::ouster::SensorInfo>& lidar, const hal::LidarLayout& layout, TimeNs pose_period);
+         const std::optional<hal::ouster::SensorInfo>& lidar, const hal::LidarLayout& layout, TimeNs pose_period,
+         bool threaded = true);
+  // the file left unfinished (its .tmp) without close()
   ~CarLog();
 
   void lidar_packet(TimeNs at, const std::uint8_t* data, std::size_t size);
@@ -61,8 +68,11 @@ class CarLog {
   void message(TimeNs at, const hal::SensorMessage& m);
   // a camera frame, as JPEG bytes, exposed at `stamp`
   void image(TimeNs at, TimeNs stamp, const std::vector<std::uint8_t>& jpeg);
+  // the same from its pixels, encoded as JPEG of this quality (on the log's thread)
+  void image(TimeNs at, const hal::CameraFrame& frame, int quality);
   // the control cycle at `at`: the command the stack sent, and what it made
-  // of the world (its estimate, map and path)
+  // of the world (its estimate, map and path); hands the cycle's messages
+  // to the log's thread
   void cycle(TimeNs at, const hal::ActuatorCommand& command, const stack::Stack& stack);
 
   // a channel of the caller's own (the simulator's truth), and a message on it
@@ -73,7 +83,11 @@ class CarLog {
   void close();
 
  private:
-  void write(std::uint16_t channel, TimeNs at, const std::uint8_t* data, std::size_t size);
+  // on the log's thread (or the caller's without one): everything below
+  // the worker but mounted_ and the next_/path_ marks, which cycle() reads
+  void write_now(std::uint16_t channel, TimeNs at, const std::uint8_t* data, std::size_t size);
+  void write_now(std::uint16_t channel, TimeNs at, const std::string& data);
+  void decode(TimeNs at, const std::uint8_t* data, std::size_t size);
 
   std::unique_ptr<log::McapWriter> mcap_;
   std::unique_ptr<hal::ouster::Decoder> decoder_;  // the clouds, from the logged packets
@@ -90,6 +104,8 @@ class CarLog {
   const void* path_of_ = nullptr;  // the trajectory last logged (its points' storage)
   std::size_t path_points_ = 0;
   double path_length_ = -1.0;
+  // last: destroyed first, running what is posted before the writer goes
+  std::unique_ptr<SerialWorker> worker_;
 };
 
 }  // namespace paddock::car
