@@ -374,6 +374,7 @@ class FastSlam {
     int size = 0;                                // slots used
     const Slot& slot(int i) const { return blocks[i / kLandmarkBlock].block->slots[i % kLandmarkBlock]; }
     Slot& mutable_slot(int i);                   // clones a shared block first
+    void clone(BlockRef& ref, LiveBlock& lb);    // (mutable_slot's copy on write)
     int add(const Slot& s);                      // a new alive slot
     void sweep();                                // lets go of the live blocks with no alive slot left
   };
@@ -437,9 +438,10 @@ class FastSlam {
   void find_candidates(const Particle& p, const Frame& f, Scratch& w);  // into w.cands
   void propose(const Particle& p, const Frame& f, const std::vector<int>& match, Scratch& w);  // into w.proposal
   void update_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik, Scratch& w);
-  void expect_and_remove(Particle& p, Scratch& w);
-  void add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double& log_lik,
-                         std::vector<std::int64_t>& ids);
+  // (cy, sy: cos and sin of the sampled pose's yaw)
+  void expect_and_remove(Particle& p, double cy, double sy, Scratch& w);
+  void add_new_landmarks(Particle& p, const Frame& f, const std::vector<int>& match, double cy, double sy,
+                         double& log_lik, std::vector<std::int64_t>& ids);
   // three standard normal draws of rng_ (a particle's, for its pose)
   Eigen::Vector3d standard_normals();
   // mean + L n, L L^T = cov (by the eigenvectors where cov is only semi-definite)
@@ -482,6 +484,7 @@ class FastSlam {
   Eigen::Matrix3d cov_ = Eigen::Matrix3d::Zero();
   std::vector<std::int64_t> seen_frames_;  // scratch of update_covariance
   void update_covariance();
+  Eigen::Matrix3d cloud_covariance(const Pose2& mean) const;  // about mean_pose(), computed once by the caller
   // scratch of resample: the parent of each new particle, the new set
   std::vector<int> picks_;
   std::vector<Particle> spare_;
