@@ -27,7 +27,6 @@ void MotionCorrector::correct(const hal::LidarScan& scan, const Odometry* odomet
   out.corrected = false;
   out.points_in = scan.points.size();
   out.invalid = 0;
-  out.points.clear();
   out.columns.clear();
 
   // the valid points in (t, ring) order: a driver's scan already is (checked
@@ -65,20 +64,16 @@ void MotionCorrector::correct(const hal::LidarScan& scan, const Odometry* odomet
   // all columns or none (a partly corrected scan would tear)
   motion_.assign(out.columns.size(), Pose2{});
   if (odometry != nullptr && !out.columns.empty()) {
-    bool covered = true;
-    for (std::size_t c = 0; c < out.columns.size() && covered; ++c) {
-      const std::optional<Pose2> T = odometry->relative(scan.end, out.columns[c].t);
-      if (T) {
-        motion_[c] = *T;
-      } else {
-        covered = false;
-      }
-    }
+    times_.clear();
+    for (const CloudColumn& col : out.columns) times_.push_back(col.t);
+    const bool covered = odometry->relative(scan.end, times_.data(), times_.size(), motion_.data());
     out.corrected = covered;
     if (!covered) std::fill(motion_.begin(), motion_.end(), Pose2{});
   }
 
   // lidar -> levelled sensor -> base at the column's time -> base at the end
+  // (every field of every point is written below: the points of the last
+  // scan are overwritten, not cleared and value-initialised first)
   out.points.resize(order_.size());
   for (std::size_t c = 0; c < out.columns.size(); ++c) {
     const Pose2& T = motion_[c];

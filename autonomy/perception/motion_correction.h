@@ -86,6 +86,7 @@ class MotionCorrector {
   double cos_pitch_ = 1.0, sin_pitch_ = 0.0;
   std::vector<std::uint32_t> order_;  // scratch: the valid points in (t, ring) order
   std::vector<Pose2> motion_;         // scratch: per column, the base at t in the base at end
+  std::vector<TimeNs> times_;         // scratch: per column, its time
 };
 
 }  // namespace paddock::perception

@@ -97,4 +97,24 @@ std::optional<Pose2> Odometry::relative(TimeNs from, TimeNs to) const {
   return Pose2{p.x, p.y, wrap_angle(b->yaw - a->yaw)};
 }
 
+bool Odometry::relative(TimeNs from, const TimeNs* to, std::size_t n, Pose2* out) const {
+  const std::optional<Pose2> a = pose_at(from);
+  if (!a) return false;
+  // a->inverse_transform(q) is rotate(q - a->position(), -a->yaw): its cosine
+  // and sine, once
+  const double c = std::cos(-a->yaw), s = std::sin(-a->yaw);
+  const TimeNs tol = from_seconds(params_.extrapolation);
+  std::size_t k = 0;  // pose_at's knot for to[i]: the last at or before it, else the first
+  for (std::size_t i = 0; i < n; ++i) {
+    const TimeNs t = to[i];
+    if (t < knots_.front().stamp - tol || t > knots_.back().stamp + tol) return false;
+    if (i > 0 && t < to[i - 1]) k = 0;  // not ascending: walk again from the start
+    while (k + 1 < knots_.size() && knots_[k + 1].stamp <= t) ++k;
+    const Pose2 b = arc(knots_[k], to_seconds(t - knots_[k].stamp));
+    const Vec2 d = b.position() - a->position();
+    out[i] = Pose2{c * d.x - s * d.y, s * d.x + c * d.y, wrap_angle(b.yaw - a->yaw)};
+  }
+  return true;
+}
+
 }  // namespace paddock::perception

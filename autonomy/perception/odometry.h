@@ -91,6 +91,14 @@ class Odometry {
   // within the extrapolation tolerance
   std::optional<Pose2> relative(TimeNs from, TimeNs to) const;
 
+  // relative(from, to[i]) for i < n into out[i], the same values to the bit,
+  // for many times against one `from` (the motion correction's per-column
+  // poses): pose_at(from) and its inverse rotation are taken once, and the
+  // knots are walked along ascending times instead of searched for each.
+  // False (out then holds no meaning) when relative() would give nullopt for
+  // any of them
+  bool relative(TimeNs from, const TimeNs* to, std::size_t n, Pose2* out) const;
+
   // the dead-reckoned pose at t in the odometry's own frame (its origin: the
   // pose where both signals were first known); nullopt as for relative()
   std::optional<Pose2> pose_at(TimeNs t) const;
