@@ -148,18 +148,51 @@ class GroundSegmenter {
     double at(double x, double y) const { return a * x + b * y + c; }
   };
 
-  void inter_ring(Cloud& cloud, GroundStats& stats) const;
+  // a stage-1 ground candidate (not vertical) as the fit reads it
+  struct FitPoint {
+    float x, y, z;
+  };
+
+  // a sector's wedge narrowed by kSectorMargin on both sides: its edges'
+  // unit directions (cosine, sine)
+  struct Wedge {
+    double lo_c, lo_s, hi_c, hi_s;
+  };
+
+  void inter_ring(Cloud& cloud, GroundStats& stats);
+  // the region of (x, y), base frame: sector * rings_ + ring
   std::size_t region_of(double x, double y) const;
-  // fits region `region` (its points in members_) from the prior plane
-  Plane fit_region(const Cloud& cloud, std::size_t region, const Plane& prior, double r_inner,
-                   double azimuth, bool& fitted) const;
+  // its parts, from (dx, dy) = (x, y) - the sensor's mount
+  std::size_t ring_of(double dx, double dy) const;
+  std::size_t sector_of(double dx, double dy) const;
+  // whether (dx, dy) lies strictly inside sector's narrowed wedge, where
+  // sector_of certainly gives `sector` (see the constructor); false for a
+  // sector >= wedges_.size()
+  bool in_sector(std::size_t sector, double dx, double dy) const;
+  // fits region `region` (its candidates in fit_points_) from the prior plane
+  Plane fit_region(std::size_t region, std::size_t sector, const Plane& prior, double r_inner,
+                   bool& fitted) const;
 
   GroundSegmentationParams params_;
   LidarCalibration calib_;
   std::size_t rings_ = 0;  // concentric regions: region_bounds.size() + 1
+  // fixed by the parameters, so computed once in the constructor (each by
+  // one expression, the same doubles as computed per region): per sector,
+  // the cosine and sine of its middle azimuth; per fit iteration, the
+  // window of the innermost region and of the others
+  std::vector<double> sector_cos_, sector_sin_;
+  std::vector<double> first_windows_, windows_;
+  // ring_of's squared bounds and in_sector's wedges (see the constructor)
+  std::vector<double> squared_bounds_;
+  std::vector<Wedge> wedges_;
   std::vector<Plane> planes_;  // sector * rings_ + ring
-  // scratch: the points bucketed by region (counting sort)
-  std::vector<std::uint32_t> region_id_, offsets_, cursor_, members_;
+  // scratch: every point's region, and the ground candidates bucketed by
+  // region (a counting sort; within a region in cloud order), copied out so
+  // that the fit's passes over a region read contiguous memory
+  std::vector<std::uint32_t> region_id_, offsets_, cursor_;
+  std::vector<std::uint32_t> ring_sector_;  // per ring, the sector of its latest return
+  std::vector<double> inv_reach_;           // per point, stage 1's 1 / (tan d + s)
+  std::vector<FitPoint> fit_points_;
 };
 
 }  // namespace paddock::perception
