@@ -51,60 +51,95 @@ ConeFilterStats ConeFilter::filter(Cloud& cloud, const GroundSegmenter& ground,
   const ConeFilterParams& p = params_;
   const double sx = calib_.mount_x, sy = calib_.mount_y;
 
-  // the ground returns a cylinder may give back, sorted by x
-  candidates_.clear();
-  for (std::size_t i = 0; i < pts.size(); ++i) {
-    if (pts[i].label == PointLabel::Ground && pts[i].height > p.reconstruction_margin) {
-      candidates_.push_back(static_cast<std::uint32_t>(i));
+  // the clusters' axes: the mean x, y of their returns
+  axes_.resize(clusters.size());
+  for (std::size_t k = 0; k < clusters.size(); ++k) {
+    double mx = 0.0, my = 0.0;
+    for (std::uint32_t m = clusters.offsets[k]; m < clusters.offsets[k + 1]; ++m) {
+      mx += pts[clusters.members[m]].x;
+      my += pts[clusters.members[m]].y;
     }
+    const double cn = static_cast<double>(clusters.offsets[k + 1] - clusters.offsets[k]);
+    axes_[k] = {mx / cn, my / cn};
   }
-  std::sort(candidates_.begin(), candidates_.end(), [&pts](std::uint32_t a, std::uint32_t b) {
-    return pts[a].x < pts[b].x || (pts[a].x == pts[b].x && a < b);
-  });
-  // the ground returns near enough to matter, binned (counting sort) into a
+
+  // the local ground around a cone's axis looks up the ground returns in a
   // square grid of cells local_ground_outer wide around the sensor, so the
-  // ring around a cone lies in the 3 x 3 cells around its own
+  // ring around a cone lies in the 3 x 3 cells around its own (the cells
+  // around_cell visits)
   const double cell = p.local_ground_outer;
   const double half = kGroundGridRange + cell;
   const int side = static_cast<int>(std::ceil(2.0 * half / cell));
+  // (a cell of a power of two metres, 1 m by default: the division by it is
+  // a multiplication by its reciprocal, which is exact then, and cheaper)
+  int cell_exponent = 0;
+  const bool cell_pow2 = std::frexp(cell, &cell_exponent) == 0.5;
+  const double inv_cell = 1.0 / cell;
+  const auto in_cells = [&](double d) { return cell_pow2 ? d * inv_cell : d / cell; };
   const auto cell_of = [&](double x, double y) -> long {
-    const double u = (x - sx + half) / cell, v = (y - sy + half) / cell;
+    const double u = in_cells(x - sx + half), v = in_cells(y - sy + half);
     if (!(u >= 0.0 && v >= 0.0 && u < side && v < side)) return -1;
     return static_cast<long>(u) * side + static_cast<long>(v);
   };
-  ground_cell_start_.assign(static_cast<std::size_t>(side) * static_cast<std::size_t>(side) + 1, 0);
+  const auto around_cell = [side](long c0, const auto& visit) {
+    const long cu = c0 / side, cv = c0 % side;
+    for (long u = std::max(0L, cu - 1); u <= std::min<long>(side - 1, cu + 1); ++u) {
+      for (long v = std::max(0L, cv - 1); v <= std::min<long>(side - 1, cv + 1); ++v) {
+        visit(static_cast<std::size_t>(u * side + v));
+      }
+    }
+  };
+  // only those cells are ever looked up: only their ground returns are
+  // binned (the lookups find the same returns in the same order)
+  const auto cells = static_cast<std::size_t>(side) * static_cast<std::size_t>(side);
+  cell_used_.assign(cells, 0);
+  for (const Vec2& axis : axes_) {
+    const long c0 = cell_of(axis.x, axis.y);
+    if (c0 >= 0) around_cell(c0, [this](std::size_t c) { cell_used_[c] = 1; });
+  }
+
+  // one pass over the cloud: the ground returns a cylinder may give back,
+  // and those in the used cells, with their cell. (Coordinates copied field
+  // by field: a whole struct built on the stack and stored at once costs a
+  // stalled load. The buffers keep their size between scans, the first n
+  // are used: no value-initialisation of them each scan)
+  const auto copy = [&pts](std::size_t i, GroundReturn& q) {
+    q.x = pts[i].x;
+    q.y = pts[i].y;
+    q.z = pts[i].z;
+    q.index = static_cast<std::uint32_t>(i);
+  };
+  if (candidates_.size() < pts.size()) candidates_.resize(pts.size());
+  if (ground_.size() < pts.size()) ground_.resize(pts.size());
+  ground_cell_.resize(pts.size());
+  ground_cell_start_.assign(cells + 1, 0);
+  std::size_t n_candidates = 0, n_ground = 0;
   for (std::size_t i = 0; i < pts.size(); ++i) {
     if (pts[i].label != PointLabel::Ground) continue;
+    if (pts[i].height > p.reconstruction_margin) copy(i, candidates_[n_candidates++]);
     const long c = cell_of(pts[i].x, pts[i].y);
-    if (c >= 0) ++ground_cell_start_[static_cast<std::size_t>(c) + 1];
+    if (c < 0 || !cell_used_[static_cast<std::size_t>(c)]) continue;
+    ++ground_cell_start_[static_cast<std::size_t>(c) + 1];
+    ground_cell_[n_ground] = static_cast<std::uint32_t>(c);
+    copy(i, ground_[n_ground++]);
   }
-  for (std::size_t c = 1; c < ground_cell_start_.size(); ++c) ground_cell_start_[c] += ground_cell_start_[c - 1];
-  ground_by_cell_.resize(ground_cell_start_.back());
-  {
-    std::vector<std::uint32_t>& fill = ground_fill_;
-    fill.assign(ground_cell_start_.begin(), ground_cell_start_.end() - 1);
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      if (pts[i].label != PointLabel::Ground) continue;
-      const long c = cell_of(pts[i].x, pts[i].y);
-      if (c >= 0) ground_by_cell_[fill[static_cast<std::size_t>(c)]++] = static_cast<std::uint32_t>(i);
-    }
-  }
-  const auto by_x = [&pts](std::uint32_t i, double x) { return pts[i].x < x; };
+  // the candidates sorted by x (then index)
+  const auto candidates_end = candidates_.begin() + static_cast<std::ptrdiff_t>(n_candidates);
+  std::sort(candidates_.begin(), candidates_end, [](const GroundReturn& a, const GroundReturn& b) {
+    return a.x < b.x || (a.x == b.x && a.index < b.index);
+  });
+  const auto by_x = [](const GroundReturn& q, double x) { return q.x < x; };
+  // the ground returns by cell (a counting sort; by index within a cell)
+  for (std::size_t c = 1; c <= cells; ++c) ground_cell_start_[c] += ground_cell_start_[c - 1];
+  if (ground_by_cell_.size() < n_ground) ground_by_cell_.resize(n_ground);
+  ground_fill_.assign(ground_cell_start_.begin(), ground_cell_start_.end() - 1);
+  for (std::size_t k = 0; k < n_ground; ++k) ground_by_cell_[ground_fill_[ground_cell_[k]]++] = ground_[k];
 
   const double rr2 = p.reconstruction_radius * p.reconstruction_radius;
   for (std::size_t k = 0; k < clusters.size(); ++k) {
     const auto begin = static_cast<std::uint32_t>(members.size());
-    // the cluster's axis: the mean x, y of its returns
-    double mx = 0.0, my = 0.0;
-    for (std::uint32_t m = clusters.offsets[k]; m < clusters.offsets[k + 1]; ++m) {
-      const std::uint32_t i = clusters.members[m];
-      mx += pts[i].x;
-      my += pts[i].y;
-      members.push_back(i);
-    }
-    const double cn = static_cast<double>(clusters.offsets[k + 1] - clusters.offsets[k]);
-    mx /= cn;
-    my /= cn;
+    for (std::uint32_t m = clusters.offsets[k]; m < clusters.offsets[k + 1]; ++m) members.push_back(clusters.members[m]);
+    const double mx = axes_[k].x, my = axes_[k].y;
     double g = ground.ground_height(mx, my);
     {
       // the local ground: the median of the ground returns around the axis
@@ -112,17 +147,13 @@ ConeFilterStats ConeFilter::filter(Cloud& cloud, const GroundSegmenter& ground,
       const double r0 = p.local_ground_inner * p.local_ground_inner, r1 = p.local_ground_outer * p.local_ground_outer;
       const long c0 = cell_of(mx, my);
       if (c0 >= 0) {
-        const long cu = c0 / side, cv = c0 % side;
-        for (long u = std::max(0L, cu - 1); u <= std::min<long>(side - 1, cu + 1); ++u) {
-          for (long v = std::max(0L, cv - 1); v <= std::min<long>(side - 1, cv + 1); ++v) {
-            const auto c = static_cast<std::size_t>(u * side + v);
-            for (std::uint32_t g_i = ground_cell_start_[c]; g_i < ground_cell_start_[c + 1]; ++g_i) {
-              const CloudPoint& q = pts[ground_by_cell_[g_i]];
-              const double dx = q.x - mx, dy = q.y - my, d2 = dx * dx + dy * dy;
-              if (d2 >= r0 && d2 <= r1) local_z_.push_back(q.z);
-            }
+        around_cell(c0, [&](std::size_t c) {
+          for (std::uint32_t g_i = ground_cell_start_[c]; g_i < ground_cell_start_[c + 1]; ++g_i) {
+            const GroundReturn& q = ground_by_cell_[g_i];
+            const double dx = q.x - mx, dy = q.y - my, d2 = dx * dx + dy * dy;
+            if (d2 >= r0 && d2 <= r1) local_z_.push_back(q.z);
           }
-        }
+        });
       }
       if (static_cast<int>(local_z_.size()) >= p.local_ground_min_points) {
         auto mid = local_z_.begin() + static_cast<std::ptrdiff_t>(local_z_.size() / 2);
@@ -132,13 +163,13 @@ ConeFilterStats ConeFilter::filter(Cloud& cloud, const GroundSegmenter& ground,
     }
 
     // reconstruction: ground returns in the cylinder, above the margin
-    auto it = std::lower_bound(candidates_.begin(), candidates_.end(), mx - p.reconstruction_radius, by_x);
+    auto it = std::lower_bound(candidates_.begin(), candidates_end, mx - p.reconstruction_radius, by_x);
     std::size_t readded = 0;
-    for (; it != candidates_.end() && pts[*it].x <= mx + p.reconstruction_radius; ++it) {
-      const CloudPoint& q = pts[*it];
+    for (; it != candidates_end && it->x <= mx + p.reconstruction_radius; ++it) {
+      const GroundReturn& q = *it;
       const double dx = q.x - mx, dy = q.y - my, h = q.z - g;
       if (dx * dx + dy * dy <= rr2 && h > p.reconstruction_margin && h < p.max_height) {
-        members.push_back(*it);
+        members.push_back(q.index);
         ++readded;
       }
     }

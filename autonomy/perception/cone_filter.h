@@ -144,10 +144,22 @@ class ConeFilter {
   ConeFilterParams params_;
   LidarCalibration calib_;
   double res_v_ = 0.0, res_h_ = 0.0;  // rad
-  std::vector<std::uint32_t> candidates_;  // scratch: ground returns that may be re-added, by x
+  // a ground return as the reconstruction and the local ground read it: a
+  // copy of its coordinates (contiguous in the order they are scanned) and
+  // its index in the cloud
+  struct GroundReturn {
+    float x, y, z;
+    std::uint32_t index;
+  };
+  std::vector<GroundReturn> candidates_;  // scratch: ground returns that may be re-added, by x
   // scratch: the ground returns within kGroundGridRange of the sensor, by grid cell
   static constexpr double kGroundGridRange = 40.0;  // m, beyond the clustering's reach
-  std::vector<std::uint32_t> ground_cell_start_, ground_by_cell_, ground_fill_;
+  std::vector<std::uint32_t> ground_cell_start_, ground_fill_;
+  std::vector<GroundReturn> ground_by_cell_;
+  std::vector<GroundReturn> ground_;        // scratch: the binned ground returns in cloud order ...
+  std::vector<std::uint32_t> ground_cell_;  // ... and their cells
+  std::vector<std::uint8_t> cell_used_;     // scratch: per cell, whether a cone's local ground looks into it
+  std::vector<Vec2> axes_;                  // scratch: per cluster, its axis (the mean x, y of its returns)
   std::vector<float> local_z_;              // scratch: the ground heights around one cone
 };
 
