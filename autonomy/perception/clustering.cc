@@ -59,6 +59,35 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t a) {
 }
 }  // namespace
 
+void Clusterer::sort_by_cell() {
+  // points_ is sorted by (ix, iy, source). When the cells' spans fit 16 bits
+  // each (always, but for a tolerance thousands of times finer than a cone),
+  // that order is the order of one 64-bit key per point, (ix - min, iy -
+  // min, position in points_), the position standing in for the source
+  // (points_ is in source order); plain integers sort far faster than the
+  // structs with their three-way comparison
+  const auto [x_lo, x_hi] = std::minmax_element(points_.begin(), points_.end(),
+                                                [](const GridPoint& a, const GridPoint& b) { return a.ix < b.ix; });
+  const auto [y_lo, y_hi] = std::minmax_element(points_.begin(), points_.end(),
+                                                [](const GridPoint& a, const GridPoint& b) { return a.iy < b.iy; });
+  const std::int64_t ix0 = x_lo->ix, iy0 = y_lo->iy;
+  if (x_hi->ix - ix0 >= 65536 || y_hi->iy - iy0 >= 65536 || points_.size() >= (std::size_t{1} << 32)) {
+    std::sort(points_.begin(), points_.end(), [](const GridPoint& a, const GridPoint& b) {
+      return a.ix != b.ix ? a.ix < b.ix : a.iy != b.iy ? a.iy < b.iy : a.source < b.source;
+    });
+    return;
+  }
+  keys_.resize(points_.size());
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    keys_[i] = static_cast<std::uint64_t>(points_[i].ix - ix0) << 48 |
+               static_cast<std::uint64_t>(points_[i].iy - iy0) << 32 | static_cast<std::uint64_t>(i);
+  }
+  std::sort(keys_.begin(), keys_.end());
+  sorted_.resize(points_.size());
+  for (std::size_t i = 0; i < keys_.size(); ++i) sorted_[i] = points_[keys_[i] & 0xffffffffu];
+  points_.swap(sorted_);
+}
+
 ClusteringStats Clusterer::cluster(const Cloud& cloud, Clusters& out) {
   ClusteringStats stats;
   out.clear();
@@ -81,9 +110,7 @@ ClusteringStats Clusterer::cluster(const Cloud& cloud, Clusters& out) {
   if (points_.empty()) return stats;
 
   // the occupied cells: runs of points sorted by cell (then by index: deterministic)
-  std::sort(points_.begin(), points_.end(), [](const GridPoint& a, const GridPoint& b) {
-    return a.ix != b.ix ? a.ix < b.ix : a.iy != b.iy ? a.iy < b.iy : a.source < b.source;
-  });
+  sort_by_cell();
   cell_start_.clear();
   idx.xy.clear();
   for (std::size_t i = 0; i < points_.size(); ++i) {

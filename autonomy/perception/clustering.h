@@ -97,7 +97,12 @@ class Clusterer {
     double x, y;          // m
     std::uint32_t source; // index in the cloud
   };
+  // sorts points_ by (ix, iy, source)
+  void sort_by_cell();
+
   std::vector<GridPoint> points_;                                  // sorted by cell
+  std::vector<std::uint64_t> keys_;                                // sort_by_cell's sort keys
+  std::vector<GridPoint> sorted_;                                  // sort_by_cell's sorted copy
   std::vector<std::uint32_t> cell_start_;                          // cell c: points_[start[c] .. start[c + 1])
   std::vector<std::uint32_t> parent_;                              // union-find over the cells
   std::vector<std::pair<std::uint32_t, std::uint32_t>> groups_;    // (root cell, cloud index)
