@@ -25,9 +25,41 @@ struct EdgeInfo {
   double length = 0.0;  // distance between the cones (m)
   // the colours around the edge as evidence that cone a's side is the blue
   // (left) one: +1 for it, -1 against, an average over the coloured cones
-  // near the midpoint (the edge's own two count double); 0 when none
+  // near the midpoint (the edge's own two count double); 0 when none. Set
+  // with the edge's cone list, the first time the search needs either
+  // (Search::near_cones)
   double colour_a_left = 0.0;
 };
+
+// the factors of a step onto an edge's midpoint that do not depend on the
+// heading the step comes from: its direction, the colour, the track width,
+// the step length and the crossing (Search::step_terms)
+struct StepTerms {
+  Vec2 u;  // unit direction of the step
+  double colour = 0.0;
+  double width = 0.0;
+  double step = 0.0;
+  double crossing = 0.0;
+};
+
+// a step from one edge's midpoint onto a neighbouring edge's (an entry of
+// the edge's neighbour list), and what the search has learnt of it so far.
+// Every node standing on an edge stands on its midpoint (Node::p is set from
+// EdgeInfo::mid and nothing else), so d, l, the factors of StepTerms and
+// the clearance test are functions of the two edges alone: computed once
+// per cycle, with the same operations on the same operands as for the
+// first node that needs them, they are bit for bit what every later node
+// would compute again.
+struct Step {
+  std::size_t to = 0;        // the edge stepped onto
+  Vec2 d;                    // its midpoint minus the one stepped from
+  double l = 0.0;            // |d| (sqrt of the squared norm, as score has it)
+  bool has_terms = false;    // `terms` is filled in
+  signed char clear = -1;    // the clearance test: -1 not run yet, 0 fails, 1 passes
+  StepTerms terms;
+};
+
+constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
 
 // a state of the search: where it stands and how it got there
 struct Node {
@@ -42,6 +74,7 @@ struct Node {
 // one scored candidate
 struct Candidate {
   std::size_t edge = 0;
+  std::size_t step = kNone;  // its entry in the neighbour list of the node's edge; none from the vehicle
   double reward = 0.0;
   RewardTerms terms;
   Node next;
@@ -62,17 +95,39 @@ struct Branch {
   }
 };
 
+// the search's working memory: its lists are kept from one call to the
+// next on the same thread (search_centreline), so that a planning cycle
+// reuses the capacity of the last one instead of allocating (and faulting
+// in) a few hundred kilobytes afresh. Every list is emptied or overwritten
+// before it is read.
+struct SearchScratch {
+  std::vector<EdgeInfo> info;
+  std::vector<char> used;
+  std::vector<std::size_t> edge_a, edge_b;
+  std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::size_t>> mid_keyed, cone_keyed;
+  std::vector<std::size_t> nb_first, nb_count;
+  std::vector<Step> steps;
+  std::vector<Vec2> cone_pos;
+  std::vector<std::size_t> cone_index, cone_first, cone_count, cone_list;
+  std::vector<std::vector<Candidate>> buffers;
+};
+
 class Search {
  public:
-  Search(const Triangulation& tri, const std::vector<Cone>& cones, const CentrelineParams& p)
-      : p_(p) {
+  Search(const Triangulation& tri, const std::vector<Cone>& cones, const CentrelineParams& p, SearchScratch& m)
+      : p_(p), cones_(cones), info_(m.info), used_(m.used), edge_a_(m.edge_a), edge_b_(m.edge_b),
+        mid_keyed_(m.mid_keyed), nb_first_(m.nb_first), nb_count_(m.nb_count), steps_(m.steps),
+        cone_pos_(m.cone_pos), cone_index_(m.cone_index), cone_keyed_(m.cone_keyed), cone_first_(m.cone_first),
+        cone_count_(m.cone_count), cone_list_(m.cone_list), buffers_(m.buffers) {
     const double wsum = p.weight_colour + p.weight_width + p.weight_angle + p.weight_step +
                         p.weight_prediction + p.weight_crossing;
     inv_weight_sum_ = 1.0 / wsum;
     cos_max_turn_ = std::cos(p.max_turn);
     cos_closure_ = std::cos(p.closure_max_angle);
     // what each edge brings by itself
-    info_.resize(tri.edges.size());
+    info_.assign(tri.edges.size(), EdgeInfo{});
+    edge_a_.clear();
+    edge_b_.clear();
     for (std::size_t i = 0; i < tri.edges.size(); ++i) {
       const TriEdge& e = tri.edges[i];
       EdgeInfo& in = info_[i];
@@ -84,8 +139,8 @@ class Search {
       edge_a_.push_back(e.a);
       edge_b_.push_back(e.b);
     }
-    build_neighbours();
-    build_cone_lists(cones, tri);
+    sort_midpoints();
+    sort_cones(tri);
     used_.assign(info_.size(), 0);
     buffers_.resize(static_cast<std::size_t>(p.horizon_depth) + 1);
   }
@@ -189,43 +244,91 @@ class Search {
   }
 
  private:
-  // the edges whose midpoints lie within the search radius of each edge's
-  // midpoint (CSR lists), by sorting the midpoints into square cells
-  void build_neighbours() {
-    const std::size_t n = info_.size();
-    const double cell = p_.search_radius;
-    const double r2 = p_.search_radius * p_.search_radius;
-    // cell coordinates, clamped so that far-away cones cannot overflow
-    auto cell_of = [&](double v) {
-      const double c = std::floor(v / cell);
-      return static_cast<std::int64_t>(std::clamp(c, -1e15, 1e15));
-    };
-    std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::size_t>> keyed(n);
-    for (std::size_t i = 0; i < n; ++i)
-      keyed[i] = {{cell_of(info_[i].mid.x), cell_of(info_[i].mid.y)}, i};
-    std::sort(keyed.begin(), keyed.end());
-    nb_begin_.assign(n + 1, 0);
-    nb_.clear();
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto key = std::make_pair(cell_of(info_[i].mid.x), cell_of(info_[i].mid.y));
-      for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        const auto lo = std::make_pair(std::make_pair(key.first + dx, key.second - 1), std::size_t{0});
-        const auto hi = std::make_pair(std::make_pair(key.first + dx, key.second + 1), n);
-        auto it = std::lower_bound(keyed.begin(), keyed.end(), lo);
-        const auto end = std::upper_bound(it, keyed.end(), hi);
-        for (; it != end; ++it) {
-          const std::size_t j = it->second;
-          if (j != i && squared_norm(info_[j].mid - info_[i].mid) <= r2) nb_.push_back(j);
-        }
-      }
-      nb_begin_[i + 1] = nb_.size();
-    }
+  // cell coordinates of a square grid, clamped so that far-away cones
+  // cannot overflow
+  static std::int64_t cell_index(double v, double cell) {
+    return static_cast<std::int64_t>(std::clamp(std::floor(v / cell), -1e15, 1e15));
   }
 
-  // one pass over the cones near each edge's midpoint:
-  //  - the cones within search_radius / 2 + min_clearance (a CSR list): a
-  //    cone closer than min_clearance to a step between two midpoints at
-  //    most search_radius apart is in the list of one of them;
+  // the midpoints sorted into square cells of the search radius, for the
+  // neighbour lists (neighbours)
+  void sort_midpoints() {
+    const std::size_t n = info_.size();
+    mid_keyed_.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      mid_keyed_[i] = {{cell_index(info_[i].mid.x, p_.search_radius), cell_index(info_[i].mid.y, p_.search_radius)}, i};
+    std::sort(mid_keyed_.begin(), mid_keyed_.end());
+    nb_first_.assign(n, kNone);
+    nb_count_.assign(n, 0);
+    steps_.clear();
+  }
+
+  // the steps from edge i's midpoint onto the midpoints within the search
+  // radius of it (in steps_ from nb_first_[i], nb_count_[i] of them), found
+  // the first time a node on edge i is expanded: of the ~330 edges of a
+  // partial autocross map about 50 are ever expanded in a cycle. Midpoints
+  // nearer than min_step are left out: score() would refuse them, and
+  // nothing else reads the list. The order is that of the cells, then of
+  // the edges' indices, as it has always been (the search's choices do not
+  // depend on it: collect sorts, best_step takes a maximum)
+  void neighbours(std::size_t i) {
+    if (nb_first_[i] != kNone) return;
+    const std::size_t n = info_.size();
+    const double r2 = p_.search_radius * p_.search_radius;
+    const double min2 = p_.min_step * p_.min_step;
+    const Vec2 m = info_[i].mid;
+    const std::int64_t cx = cell_index(m.x, p_.search_radius), cy = cell_index(m.y, p_.search_radius);
+    nb_first_[i] = steps_.size();
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      const auto lo = std::make_pair(std::make_pair(cx + dx, cy - 1), std::size_t{0});
+      const auto hi = std::make_pair(std::make_pair(cx + dx, cy + 1), n);
+      auto it = std::lower_bound(mid_keyed_.begin(), mid_keyed_.end(), lo);
+      const auto end = std::upper_bound(it, mid_keyed_.end(), hi);
+      for (; it != end; ++it) {
+        const std::size_t j = it->second;
+        if (j == i) continue;
+        // d and its squared norm exactly as score() has them for a node on edge i
+        const Vec2 d = info_[j].mid - m;
+        const double l2 = squared_norm(d);
+        if (l2 < min2 || l2 > r2) continue;
+        Step st;
+        st.to = j;
+        st.d = d;
+        st.l = std::sqrt(l2);
+        steps_.push_back(st);
+      }
+    }
+    nb_count_[i] = steps_.size() - nb_first_[i];
+  }
+
+  // the triangulated cones, and the same sorted into square cells (for
+  // near_cones)
+  void sort_cones(const Triangulation& tri) {
+    cone_pos_.clear();
+    cone_index_.clear();
+    for (std::size_t i = 0; i < cones_.size(); ++i)
+      if (i < tri.representative.size() && tri.representative[i] == i) {
+        cone_pos_.push_back(cones_[i].position);
+        cone_index_.push_back(i);
+      }
+    reach_list_ = 0.5 * p_.search_radius + p_.min_clearance;
+    cone_cell_ = std::max(std::max(reach_list_, p_.colour_radius), 1.0);
+    cone_keyed_.resize(cone_pos_.size());
+    for (std::size_t i = 0; i < cone_pos_.size(); ++i)
+      cone_keyed_[i] = {{cell_index(cone_pos_[i].x, cone_cell_), cell_index(cone_pos_[i].y, cone_cell_)}, i};
+    std::sort(cone_keyed_.begin(), cone_keyed_.end());
+    cone_first_.assign(info_.size(), kNone);
+    cone_count_.assign(info_.size(), 0);
+    cone_list_.clear();
+  }
+
+  // one pass over the cones near edge e's midpoint, the first time the
+  // search needs it (a step onto e is scored, or one from or onto it is
+  // tested for clearance):
+  //  - the cones within search_radius / 2 + min_clearance (cone_list_ from
+  //    cone_first_[e]): a cone closer than min_clearance to a step between
+  //    two midpoints at most search_radius apart is in the list of one of
+  //    them;
   //  - the colour evidence (EdgeInfo::colour_a_left): a blue cone on cone
   //    a's side of the midpoint, or a yellow one on b's side, says a's side
   //    is the left one. A neighbour's side is that of its projection onto
@@ -234,74 +337,70 @@ class Search {
   //    boundary, or the strip between two lanes) counts against either way.
   //    Averaged over several cones, one swapped colour does not turn a
   //    boundary into a rung.
-  void build_cone_lists(const std::vector<Cone>& cones, const Triangulation& tri) {
-    for (std::size_t i = 0; i < cones.size(); ++i)
-      if (i < tri.representative.size() && tri.representative[i] == i) {
-        cone_pos_.push_back(cones[i].position);
-        cone_index_.push_back(i);
-      }
-    const std::size_t n = info_.size();
-    const double reach_list = 0.5 * p_.search_radius + p_.min_clearance;
-    const double reach = std::max(reach_list, p_.colour_radius);
-    const double list2 = reach_list * reach_list, colour2 = p_.colour_radius * p_.colour_radius;
-    const double cell = std::max(reach, 1.0);
-    auto cell_of = [&](double v) {
-      return static_cast<std::int64_t>(std::clamp(std::floor(v / cell), -1e15, 1e15));
-    };
+  // Each edge's pass is independent of the others', so doing it on demand
+  // gives the same lists and the same sums in the same order.
+  void near_cones(std::size_t e) {
+    if (cone_first_[e] != kNone) return;
+    const std::vector<Cone>& cones = cones_;
+    const double list2 = reach_list_ * reach_list_, colour2 = p_.colour_radius * p_.colour_radius;
     auto coloured = [](ConeColor c) { return c == ConeColor::Blue || c == ConeColor::Yellow; };
     auto vote = [](ConeColor c, bool a_side) { return (c == ConeColor::Blue) == a_side ? 1.0 : -1.0; };
-    std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::size_t>> keyed(cone_pos_.size());
-    for (std::size_t i = 0; i < cone_pos_.size(); ++i)
-      keyed[i] = {{cell_of(cone_pos_[i].x), cell_of(cone_pos_[i].y)}, i};
-    std::sort(keyed.begin(), keyed.end());
-    cone_begin_.assign(n + 1, 0);
-    cone_list_.clear();
-    for (std::size_t e = 0; e < n; ++e) {
-      EdgeInfo& in = info_[e];
-      const Vec2 m = in.mid;
-      const std::size_t ia = edge_a_[e], ib = edge_b_[e];
-      double sum = 0.0, weight = 0.0;
-      const bool same = coloured(cones[ia].color) && cones[ia].color == cones[ib].color;
-      for (std::size_t i : {ia, ib}) {
-        if (!coloured(cones[i].color)) continue;
-        sum += 2.0 * (same ? -1.0 : vote(cones[i].color, i == ia));
-        weight += 2.0;
-      }
-      const std::int64_t cx = cell_of(m.x), cy = cell_of(m.y);
-      for (std::int64_t dx = -1; dx <= 1; ++dx) {
-        const auto lo = std::make_pair(std::make_pair(cx + dx, cy - 1), std::size_t{0});
-        const auto hi = std::make_pair(std::make_pair(cx + dx, cy + 1), cone_pos_.size());
-        auto it = std::lower_bound(keyed.begin(), keyed.end(), lo);
-        const auto end = std::upper_bound(it, keyed.end(), hi);
-        for (; it != end; ++it) {
-          const Vec2 d = cone_pos_[it->second] - m;
-          const double d2 = squared_norm(d);
-          if (d2 <= list2) cone_list_.push_back(it->second);
-          const std::size_t q = cone_index_[it->second];
-          if (d2 > colour2 || q == ia || q == ib || !coloured(cones[q].color)) continue;
-          const double t = dot(d, -in.dir);  // > 0 on a's side (dir points from a to b)
-          if (t * t < 0.0625 * d2) continue;
-          sum += vote(cones[q].color, t > 0.0);
-          weight += 1.0;
-        }
-      }
-      in.colour_a_left = weight > 0.0 ? sum / weight : 0.0;
-      cone_begin_[e + 1] = cone_list_.size();
+    EdgeInfo& in = info_[e];
+    const Vec2 m = in.mid;
+    const std::size_t ia = edge_a_[e], ib = edge_b_[e];
+    double sum = 0.0, weight = 0.0;
+    const bool same = coloured(cones[ia].color) && cones[ia].color == cones[ib].color;
+    for (std::size_t i : {ia, ib}) {
+      if (!coloured(cones[i].color)) continue;
+      sum += 2.0 * (same ? -1.0 : vote(cones[i].color, i == ia));
+      weight += 2.0;
     }
+    cone_first_[e] = cone_list_.size();
+    const std::int64_t cx = cell_index(m.x, cone_cell_), cy = cell_index(m.y, cone_cell_);
+    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+      const auto lo = std::make_pair(std::make_pair(cx + dx, cy - 1), std::size_t{0});
+      const auto hi = std::make_pair(std::make_pair(cx + dx, cy + 1), cone_pos_.size());
+      auto it = std::lower_bound(cone_keyed_.begin(), cone_keyed_.end(), lo);
+      const auto end = std::upper_bound(it, cone_keyed_.end(), hi);
+      for (; it != end; ++it) {
+        const Vec2 d = cone_pos_[it->second] - m;
+        const double d2 = squared_norm(d);
+        if (d2 <= list2) cone_list_.push_back(it->second);
+        const std::size_t q = cone_index_[it->second];
+        if (d2 > colour2 || q == ia || q == ib || !coloured(cones[q].color)) continue;
+        const double t = dot(d, -in.dir);  // > 0 on a's side (dir points from a to b)
+        if (t * t < 0.0625 * d2) continue;
+        sum += vote(cones[q].color, t > 0.0);
+        weight += 1.0;
+      }
+    }
+    in.colour_a_left = weight > 0.0 ? sum / weight : 0.0;
+    cone_count_[e] = cone_list_.size() - cone_first_[e];
   }
 
-  // true when the step from s (a midpoint) onto edge c's midpoint keeps
-  // min_clearance from every cone: it does not cut through a boundary
-  bool clear(const Node& s, std::size_t c) const {
-    if (s.edge == kNoCone) return clear_all(s, c);
+  // true when the step of candidate c from s (a midpoint) onto its edge's
+  // midpoint keeps min_clearance from every cone: it does not cut through a
+  // boundary. Between two midpoints the answer is kept in the step
+  bool clear(const Node& s, const Candidate& c) {
+    if (s.edge == kNoCone) return clear_all(s, c.edge);
+    signed char& known = steps_[c.step].clear;
+    if (known < 0) known = clear_between(s.edge, c.edge) ? 1 : 0;
+    return known == 1;
+  }
+
+  // the step between the midpoints of edges a and b against the cones near either
+  bool clear_between(std::size_t a, std::size_t b) {
+    near_cones(a);
+    near_cones(b);
     const double c2 = p_.min_clearance * p_.min_clearance;
+    const Vec2 from = info_[a].mid, to = info_[b].mid;
     auto near = [&](std::size_t i) {
       const Vec2 q = cone_pos_[i];
-      return squared_norm(q - closest_on_segment(s.p, info_[c].mid, q)) < c2;
+      return squared_norm(q - closest_on_segment(from, to, q)) < c2;
     };
-    for (std::size_t k = cone_begin_[s.edge]; k < cone_begin_[s.edge + 1]; ++k)
+    for (std::size_t k = cone_first_[a]; k < cone_first_[a] + cone_count_[a]; ++k)
       if (near(cone_list_[k])) return false;
-    for (std::size_t k = cone_begin_[c]; k < cone_begin_[c + 1]; ++k)
+    for (std::size_t k = cone_first_[b]; k < cone_first_[b] + cone_count_[b]; ++k)
       if (near(cone_list_[k])) return false;
     return true;
   }
@@ -328,41 +427,78 @@ class Search {
     return n;
   }
 
-  // the reward of stepping from s onto edge c's midpoint; false when the
-  // midpoint is not a candidate (too near, too far, outside the forward cone)
-  bool score(const Node& s, std::size_t c, Candidate& out) const {
+  // the factors of the step d (of length l) onto edge c's midpoint that do
+  // not depend on the heading it comes from
+  StepTerms step_terms(Vec2 d, double l, std::size_t c) {
+    near_cones(c);  // the colour evidence
     const EdgeInfo& e = info_[c];
-    const Vec2 d = e.mid - s.p;
-    const double l2 = squared_norm(d);
-    if (l2 < p_.min_step * p_.min_step || l2 > p_.search_radius * p_.search_radius) return false;
-    const double l = std::sqrt(l2);
+    StepTerms t;
+    t.u = d / l;
+    // colour: blue on the left and yellow on the right of the step
+    t.colour = cross(t.u, e.a - e.mid) > 0.0 ? e.colour_a_left : -e.colour_a_left;
+    // the track width: the edge's extent across the direction of travel (a
+    // diagonal rung between staggered cones is longer than the track is wide)
+    const double across_edge = std::abs(cross(t.u, e.dir));
+    t.width = track_width_reward(e.length * across_edge, p_);
+    t.step = bell(l - p_.step_preferred, p_.step_sigma);
+    // a track crossing (rung) is crossed squarely, a boundary edge lengthwise
+    t.crossing = 2.0 * across_edge - 1.0;
+    return t;
+  }
+
+  // the reward of stepping from s onto edge c's midpoint (`step`: the entry
+  // of c in the neighbour list of s's edge, kNone from the vehicle); false
+  // when the midpoint is not a candidate (too near, too far, outside the
+  // forward cone)
+  bool score(const Node& s, std::size_t c, std::size_t step, Candidate& out) {
+    const EdgeInfo& e = info_[c];
+    Vec2 d;
+    double l = 0.0;
+    if (step == kNone) {
+      d = e.mid - s.p;
+      const double l2 = squared_norm(d);
+      if (l2 < p_.min_step * p_.min_step || l2 > p_.search_radius * p_.search_radius) return false;
+      l = std::sqrt(l2);
+    } else {
+      // the neighbour list holds only midpoints in range
+      d = steps_[step].d;
+      l = steps_[step].l;
+    }
     const double along = dot(s.dir, d);
     if (along < cos_max_turn_ * l) return false;
     const double across = cross(s.dir, d);
-    const Vec2 u = d / l;
+    StepTerms fresh;
+    const StepTerms* st = &fresh;
+    if (step == kNone) {
+      fresh = step_terms(d, l, c);
+    } else {
+      Step& known = steps_[step];
+      if (!known.has_terms) {
+        known.terms = step_terms(d, l, c);
+        known.has_terms = true;
+      }
+      st = &known.terms;
+    }
     RewardTerms t;
-    // colour: blue on the left and yellow on the right of the step
-    t.colour = cross(u, e.a - e.mid) > 0.0 ? e.colour_a_left : -e.colour_a_left;
-    // the track width: the edge's extent across the direction of travel (a
-    // diagonal rung between staggered cones is longer than the track is wide)
-    t.width = track_width_reward(e.length * std::abs(cross(u, e.dir)), p_);
+    t.colour = st->colour;
+    t.width = st->width;
     const double turn = std::atan2(across, along);
     t.angle = bell(turn, p_.angle_sigma);
-    t.step = bell(l - p_.step_preferred, p_.step_sigma);
+    t.step = st->step;
     // the prediction: the heading turned as much again as over the last two
     // steps on average (the midpoints zig-zag), at this candidate's distance
     const Vec2 predicted = s.p + s.pred_dir * l;
     t.prediction = bell(std::sqrt(squared_norm(e.mid - predicted)), p_.prediction_sigma);
-    // a track crossing (rung) is crossed squarely, a boundary edge lengthwise
-    t.crossing = 2.0 * std::abs(cross(u, e.dir)) - 1.0;
+    t.crossing = st->crossing;
     out.edge = c;
+    out.step = step;
     out.terms = t;
     out.reward = (p_.weight_colour * t.colour + p_.weight_width * t.width +
                   p_.weight_angle * t.angle + p_.weight_step * t.step +
                   p_.weight_prediction * t.prediction + p_.weight_crossing * t.crossing) *
                  inv_weight_sum_;
     out.next.p = e.mid;
-    out.next.dir = u;
+    out.next.dir = st->u;
     out.next.turn = 0.5 * (turn + s.last_turn);
     out.next.last_turn = turn;
     out.next.edge = c;
@@ -373,16 +509,17 @@ class Search {
 
   // the best `keep` candidates from s above min_reward that keep clear of
   // the cones, best first
-  void collect(const Node& s, const Branch& branch, int keep, std::vector<Candidate>& out) const {
+  void collect(const Node& s, const Branch& branch, int keep, std::vector<Candidate>& out) {
     out.clear();
     Candidate c;
-    auto consider = [&](std::size_t j) {
-      if (candidate(s, j, branch, c)) out.push_back(c);
-    };
     if (s.edge == kNoCone) {
-      for (std::size_t j = 0; j < info_.size(); ++j) consider(j);
+      for (std::size_t j = 0; j < info_.size(); ++j)
+        if (candidate(s, j, kNone, branch, c)) out.push_back(c);
     } else {
-      for (std::size_t k = nb_begin_[s.edge]; k < nb_begin_[s.edge + 1]; ++k) consider(nb_[k]);
+      neighbours(s.edge);
+      const std::size_t first = nb_first_[s.edge], last = first + nb_count_[s.edge];
+      for (std::size_t k = first; k < last; ++k)
+        if (candidate(s, steps_[k].to, k, branch, c)) out.push_back(c);
     }
     // best first; ties by edge index so the order never depends on the sort
     std::sort(out.begin(), out.end(), [](const Candidate& x, const Candidate& y) {
@@ -391,15 +528,16 @@ class Search {
     // the clearance test last (it is the costly one), best first, until the beam is full
     std::size_t n = 0;
     for (std::size_t k = 0; k < out.size() && n < static_cast<std::size_t>(keep); ++k) {
-      if (clear(s, out[k].edge)) out[n++] = out[k];
+      if (clear(s, out[k])) out[n++] = out[k];
     }
     out.resize(n);
   }
 
-  // scores edge j as the next step from s into c: false when it is no
-  // candidate (reused, too near or far, outside the forward cone, below
-  // min_reward); the clearance is not tested here
-  bool candidate(const Node& s, std::size_t j, const Branch& branch, Candidate& c) const {
+  // scores edge j (`step`: its entry in the neighbour list of s's edge) as
+  // the next step from s into c: false when it is no candidate (reused, too
+  // near or far, outside the forward cone, below min_reward); the clearance
+  // is not tested here
+  bool candidate(const Node& s, std::size_t j, std::size_t step, const Branch& branch, Candidate& c) {
     if (j == s.edge || branch.contains(j)) return false;
     int target = -1;
     if (used_[j]) {
@@ -409,7 +547,7 @@ class Search {
         if ((*first_points_)[static_cast<std::size_t>(k)].edge == j) target = k;
       if (target < 0) return false;
     }
-    if (!score(s, j, c) || !(c.reward >= p_.min_reward)) return false;
+    if (!score(s, j, step, c) || !(c.reward >= p_.min_reward)) return false;
     if (target >= 0) {
       // ... heading the way the path first went through that point
       const Vec2 first = (*arrival_)[static_cast<std::size_t>(target)];
@@ -422,13 +560,14 @@ class Search {
 
   // the best reward of one more step from s (the last level of the
   // look-ahead: no list, no sort; clearance only for a better candidate)
-  double best_step(const Node& s, const Branch& branch) const {
+  double best_step(const Node& s, const Branch& branch) {
     double best = 0.0;
     Candidate c;
-    for (std::size_t k = nb_begin_[s.edge]; k < nb_begin_[s.edge + 1]; ++k) {
-      const std::size_t j = nb_[k];
-      if (!candidate(s, j, branch, c) || c.reward <= best) continue;
-      if (clear(s, j)) best = c.reward;
+    neighbours(s.edge);
+    const std::size_t first = nb_first_[s.edge], last = first + nb_count_[s.edge];
+    for (std::size_t k = first; k < last; ++k) {
+      if (!candidate(s, steps_[k].to, k, branch, c) || c.reward <= best) continue;
+      if (clear(s, c)) best = c.reward;
     }
     return best;
   }
@@ -457,15 +596,28 @@ class Search {
     return best;
   }
 
+  using Keyed = std::vector<std::pair<std::pair<std::int64_t, std::int64_t>, std::size_t>>;
   const CentrelineParams& p_;
-  std::vector<EdgeInfo> info_;
-  std::vector<std::size_t> nb_begin_, nb_;
-  std::vector<char> used_;
-  std::vector<Vec2> cone_pos_;                  // the triangulated cones
-  std::vector<std::size_t> cone_index_;         // their indices in the input
-  std::vector<std::size_t> edge_a_, edge_b_;    // each edge's cones (input indices)
-  std::vector<std::size_t> cone_begin_, cone_list_;  // CSR: cones near each edge
-  std::vector<std::vector<Candidate>> buffers_;  // one per look-ahead level
+  const std::vector<Cone>& cones_;
+  // the lists live in a SearchScratch
+  std::vector<EdgeInfo>& info_;
+  std::vector<char>& used_;
+  std::vector<std::size_t>& edge_a_;  // each edge's cones (input indices)
+  std::vector<std::size_t>& edge_b_;
+  // the neighbour lists, built on demand (neighbours)
+  Keyed& mid_keyed_;                    // the midpoints by cell
+  std::vector<std::size_t>& nb_first_;  // per edge, its steps in steps_ (kNone: not built)
+  std::vector<std::size_t>& nb_count_;
+  std::vector<Step>& steps_;
+  // the cones near each edge, on demand (near_cones)
+  std::vector<Vec2>& cone_pos_;           // the triangulated cones
+  std::vector<std::size_t>& cone_index_;  // their indices in the input
+  Keyed& cone_keyed_;                     // the same by cell
+  std::vector<std::size_t>& cone_first_;  // per edge, its cones in cone_list_ (kNone: not yet)
+  std::vector<std::size_t>& cone_count_;
+  std::vector<std::size_t>& cone_list_;
+  std::vector<std::vector<Candidate>>& buffers_;  // one per look-ahead level
+  double reach_list_ = 0.0, cone_cell_ = 1.0;
   double inv_weight_sum_ = 1.0;
   double cos_max_turn_ = 0.0;
   double cos_closure_ = 0.0;
@@ -565,7 +717,8 @@ CentrelineResult search_centreline(const Triangulation& tri, const std::vector<C
       return out;
     }
   }
-  Search search(tri, cones, params);
+  thread_local SearchScratch scratch;
+  Search search(tri, cones, params, scratch);
   return search.run(start);
 }
 
