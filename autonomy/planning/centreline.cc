@@ -60,6 +60,8 @@ struct Step {
 };
 
 constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+// no floor under the rewards a caller wants (Search::candidate)
+constexpr double kNoFloor = -std::numeric_limits<double>::infinity();
 
 // a state of the search: where it stands and how it got there
 struct Node {
@@ -449,8 +451,9 @@ class Search {
   // the reward of stepping from s onto edge c's midpoint (`step`: the entry
   // of c in the neighbour list of s's edge, kNone from the vehicle); false
   // when the midpoint is not a candidate (too near, too far, outside the
-  // forward cone)
-  bool score(const Node& s, std::size_t c, std::size_t step, Candidate& out) {
+  // forward cone), and when its reward cannot reach min_reward or exceed
+  // `floor` (the callers would drop it)
+  bool score(const Node& s, std::size_t c, std::size_t step, double floor, Candidate& out) {
     const EdgeInfo& e = info_[c];
     Vec2 d;
     double l = 0.0;
@@ -479,6 +482,15 @@ class Search {
       }
       st = &known.terms;
     }
+    // the reward with the angle and prediction factors at their largest (1;
+    // bell() <= 1) bounds the reward from above: the weights are >= 0 and
+    // rounding is monotonic, so the same sum below cannot come out larger.
+    // A step it rules out needs neither atan2 nor the prediction
+    const double bound = (p_.weight_colour * st->colour + p_.weight_width * st->width +
+                          p_.weight_angle * 1.0 + p_.weight_step * st->step +
+                          p_.weight_prediction * 1.0 + p_.weight_crossing * st->crossing) *
+                         inv_weight_sum_;
+    if (bound < p_.min_reward || bound <= floor) return false;
     RewardTerms t;
     t.colour = st->colour;
     t.width = st->width;
@@ -514,12 +526,12 @@ class Search {
     Candidate c;
     if (s.edge == kNoCone) {
       for (std::size_t j = 0; j < info_.size(); ++j)
-        if (candidate(s, j, kNone, branch, c)) out.push_back(c);
+        if (candidate(s, j, kNone, branch, kNoFloor, c)) out.push_back(c);
     } else {
       neighbours(s.edge);
       const std::size_t first = nb_first_[s.edge], last = first + nb_count_[s.edge];
       for (std::size_t k = first; k < last; ++k)
-        if (candidate(s, steps_[k].to, k, branch, c)) out.push_back(c);
+        if (candidate(s, steps_[k].to, k, branch, kNoFloor, c)) out.push_back(c);
     }
     // best first; ties by edge index so the order never depends on the sort
     std::sort(out.begin(), out.end(), [](const Candidate& x, const Candidate& y) {
@@ -535,9 +547,10 @@ class Search {
 
   // scores edge j (`step`: its entry in the neighbour list of s's edge) as
   // the next step from s into c: false when it is no candidate (reused, too
-  // near or far, outside the forward cone, below min_reward); the clearance
-  // is not tested here
-  bool candidate(const Node& s, std::size_t j, std::size_t step, const Branch& branch, Candidate& c) {
+  // near or far, outside the forward cone, below min_reward), or when its
+  // reward is not above `floor`; the clearance is not tested here
+  bool candidate(const Node& s, std::size_t j, std::size_t step, const Branch& branch, double floor,
+                 Candidate& c) {
     if (j == s.edge || branch.contains(j)) return false;
     int target = -1;
     if (used_[j]) {
@@ -547,7 +560,7 @@ class Search {
         if ((*first_points_)[static_cast<std::size_t>(k)].edge == j) target = k;
       if (target < 0) return false;
     }
-    if (!score(s, j, step, c) || !(c.reward >= p_.min_reward)) return false;
+    if (!score(s, j, step, floor, c) || !(c.reward >= p_.min_reward)) return false;
     if (target >= 0) {
       // ... heading the way the path first went through that point
       const Vec2 first = (*arrival_)[static_cast<std::size_t>(target)];
@@ -566,7 +579,7 @@ class Search {
     neighbours(s.edge);
     const std::size_t first = nb_first_[s.edge], last = first + nb_count_[s.edge];
     for (std::size_t k = first; k < last; ++k) {
-      if (!candidate(s, steps_[k].to, k, branch, c) || c.reward <= best) continue;
+      if (!candidate(s, steps_[k].to, k, branch, best, c) || c.reward <= best) continue;
       if (clear(s, c)) best = c.reward;
     }
     return best;
