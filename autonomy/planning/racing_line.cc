@@ -4,10 +4,9 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
-#include <memory>
 #include <optional>
 
-#include <ceres/ceres.h>
+#include <ceres/jet.h>
 
 #include "autonomy/common/polyline.h"
 #include "autonomy/planning/interior_point.h"
@@ -76,7 +75,11 @@ constexpr double kClearanceTolerance = 0.005;
 
 // the cost as sum_k r_k(a)^2 for the interior-point solver: one Menger
 // residual per inner point, a function of its offset and its neighbours',
-// its gradient from Ceres' automatic differentiation
+// its gradient from Ceres' automatic differentiation (its Jet type: the
+// functor is called here as ceres::AutoDiffCostFunction<MengerResidual, 1,
+// 1, 1, 1>::Evaluate would call it, one Jet per offset with its own unit
+// derivative, without the virtual call and the copying in and out; the
+// same operations, so the same bits)
 class MengerTerms : public SparseLeastSquares {
  public:
   MengerTerms(const std::vector<Vec2>& r, const std::vector<Vec2>& normal, bool closed) {
@@ -84,8 +87,7 @@ class MengerTerms : public SparseLeastSquares {
     for (std::size_t i = closed ? 0 : 1; i < (closed ? n : n - 1); ++i) {
       const std::size_t a = (i + n - 1) % n, c = (i + 1) % n;
       terms_.push_back({{static_cast<int>(a), static_cast<int>(i), static_cast<int>(c)},
-                        std::make_unique<ceres::AutoDiffCostFunction<MengerResidual, 1, 1, 1, 1>>(
-                            new MengerResidual{r[a], r[i], r[c], normal[a], normal[i], normal[c]})});
+                        MengerResidual{r[a], r[i], r[c], normal[a], normal[i], normal[c]}});
     }
   }
 
@@ -94,17 +96,23 @@ class MengerTerms : public SparseLeastSquares {
   const int* variables(std::size_t k) const override { return terms_[k].index; }
   double residual(std::size_t k, const double* x, double* jacobian) const override {
     const Term& t = terms_[k];
-    const double* params[3] = {&x[t.index[0]], &x[t.index[1]], &x[t.index[2]]};
-    double* jac[3] = {jacobian, jacobian ? jacobian + 1 : nullptr, jacobian ? jacobian + 2 : nullptr};
-    double value = 0.0;
-    if (!t.cost->Evaluate(params, &value, jacobian ? jac : nullptr)) return std::numeric_limits<double>::quiet_NaN();
-    return value;
+    if (!jacobian) {
+      double value = 0.0;
+      t.cost(&x[t.index[0]], &x[t.index[1]], &x[t.index[2]], &value);
+      return value;
+    }
+    using Jet = ceres::Jet<double, 3>;
+    const Jet a0(x[t.index[0]], 0), a1(x[t.index[1]], 1), a2(x[t.index[2]], 2);
+    Jet value;
+    t.cost(&a0, &a1, &a2, &value);
+    for (int p = 0; p < 3; ++p) jacobian[p] = value.v[p];
+    return value.a;
   }
 
  private:
   struct Term {
     int index[3];
-    std::unique_ptr<ceres::CostFunction> cost;
+    MengerResidual cost;
   };
   std::vector<Term> terms_;
 };
