@@ -290,7 +290,7 @@ SimState::SimState(const SimModel& model, WireTap* tap)
       wheel_speeds(model.scenario.wheel_speeds, stream_seed(model.scenario.scenario.seed, "wheel_speeds")),
       steering(model.scenario.steering_sensor, stream_seed(model.scenario.scenario.seed, "steering_sensor")),
       true_poses(model.pose_history_span),
-      profile(&Profile::Clock::now, allocations_counted() ? &thread_allocations : nullptr) {
+      profile(nullptr, allocations_counted() ? &thread_allocations : nullptr) {
   hal.set_tap(tap);
   stack.set_profile(&profile);
   if (raw) raw->set_profile(&profile);

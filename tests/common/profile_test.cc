@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <thread>
+
 namespace paddock {
 namespace {
 
@@ -60,6 +62,30 @@ TEST(Profile, ScopesDeeperThanItsStackAreChargedToTheDeepestItHolds) {
   EXPECT_DOUBLE_EQ(p.seconds(Stage::Control), 0.0);
   EXPECT_EQ(p.entries(Stage::Control), 5u);
   EXPECT_EQ(stage_name(Stage::Localisation), "localisation");
+}
+
+// the CPU's counter, its rate measured against steady_clock: a stage's
+// time is what steady_clock saw pass in it, and the whole is the time
+// from start() to stop() by steady_clock
+TEST(Profile, TheCpusCounterGivesSteadyClocksSeconds) {
+  using Clock = Profile::Clock;
+  const auto seconds = [](Clock::time_point from, Clock::time_point to) {
+    return std::chrono::duration<double>(to - from).count();
+  };
+  Profile p;
+  const Clock::time_point t0 = Clock::now();
+  p.start();
+  p.enter(Stage::Camera);
+  const Clock::time_point c0 = Clock::now();
+  std::this_thread::sleep_for(std::chrono::milliseconds(30));
+  const Clock::time_point c1 = Clock::now();
+  p.leave();
+  p.stop();
+  const Clock::time_point t1 = Clock::now();
+  EXPECT_NEAR(p.seconds(Stage::Camera), seconds(c0, c1), 0.005);
+  EXPECT_GE(p.total(), seconds(c0, c1) - 1e-6);
+  EXPECT_LE(p.total(), seconds(t0, t1) + 1e-6);
+  EXPECT_LT(p.seconds(Stage::Other), 0.005);
 }
 
 std::uint64_t fake_allocations = 0;
