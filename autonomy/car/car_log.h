@@ -54,7 +54,8 @@ class CarLog {
   // encoding (JSON, JPEG, the clouds' decode), compression and writing are
   // done on a thread of the log's own (a SerialWorker: in the order the
   // calls came, so the file's bytes are the same either way; a problem it
-  // meets is thrown by a later cycle() or close()); false: on the caller's
+  // meets is thrown by a later cycle() or close()); false: all on the
+  // caller's thread
   CarLog(const std::string& path, const std::vector<File>& attachments, const log::KeyValues& metadata,
          const std::optional<hal::ouster::SensorInfo>& lidar, const hal::LidarLayout& layout, TimeNs pose_period,
          bool threaded = true);
@@ -83,8 +84,9 @@ class CarLog {
   void close();
 
  private:
-  // on the log's thread (or the caller's without one): everything below
-  // the worker but mounted_ and the next_/path_ marks, which cycle() reads
+  // these run on the log's thread (the caller's without one), and the
+  // members below are that thread's, but for mounted_ and the next_ and
+  // path_ marks: cycle() decides on the caller's thread what is due
   void write_now(std::uint16_t channel, TimeNs at, const std::uint8_t* data, std::size_t size);
   void write_now(std::uint16_t channel, TimeNs at, const std::string& data);
   void decode(TimeNs at, const std::uint8_t* data, std::size_t size);
