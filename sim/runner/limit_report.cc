@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <future>
 #include <map>
 #include <mutex>
@@ -96,14 +97,15 @@ std::string hash_hex(const std::string& text) {
 }
 
 // The car's envelope kept on disk between runs: measuring it costs about a
-// second of CPU (~1,000 s of the car driven at 1 kHz), a fifth of a one-lap
+// second of CPU (~1,000 s of the car driven at 1 kHz), a third of a one-lap
 // run on one core, and every run of the same car in the same program
 // measures the same numbers. An entry is the envelope's keys, each number
 // as the shortest text that reads back to the same double, under this
 // program's build ID (other code: another entry) and the car's fingerprint
 // (its every parameter, exactly), hashed into the file's name and into the
 // file: a result the program and the car alone determine, so a run that
-// reads it gives what one that measures gives, bit for bit (tested)
+// reads it gives what one that measures gives, bit for bit (tested). The
+// folder keeps the 64 latest entries
 struct EnvelopeCache {
   std::string path;      // "" when nothing can be kept (no cache folder or no build ID)
   std::string build;     // the program's build ID
@@ -156,6 +158,28 @@ struct EnvelopeCache {
     try {
       write_file_atomic(path, text);
     } catch (const UserError&) {
+      return;
+    }
+    prune();
+  }
+
+  // every build of the program keeps its own entries: the folder holds the
+  // kKept most recently written, the others are removed
+  static constexpr std::size_t kKept = 64;
+  void prune() const {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    std::vector<std::pair<fs::file_time_type, fs::path>> entries;
+    for (const fs::directory_entry& f : fs::directory_iterator(fs::path(path).parent_path(), ec)) {
+      const std::string name = f.path().filename().string();
+      if (name.rfind("car-envelope-", 0) != 0 || f.path().extension() != ".ini") continue;
+      const fs::file_time_type t = f.last_write_time(ec);
+      if (!ec) entries.emplace_back(t, f.path());
+    }
+    if (entries.size() <= kKept) return;
+    std::sort(entries.begin(), entries.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (std::size_t i = kKept; i < entries.size(); ++i) {
+      if (entries[i].second != fs::path(path)) fs::remove(entries[i].second, ec);
     }
   }
 };

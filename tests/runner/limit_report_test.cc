@@ -10,6 +10,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -172,7 +173,7 @@ std::vector<fs::path> files_in(const std::string& dir) {
 // the car's envelope kept between runs: what a run reads back is what a
 // measurement gives, bit for bit; it is read (not measured again) while
 // the file is whole, and measured again and rewritten when the file is of
-// another build or broken
+// another build or broken; the folder keeps the latest 64 entries
 TEST(KeptCarEnvelope, ReadsBackTheMeasurementAndMeasuresAgainWhenTheFileIsNotWhole) {
   const std::string dir = scratch("cache");
   fs::remove_all(dir);
@@ -180,7 +181,21 @@ TEST(KeptCarEnvelope, ReadsBackTheMeasurementAndMeasuresAgainWhenTheFileIsNotWho
   const Scenario s = load_scenario(kRoot + "/scenarios/fsg_2023_trackdrive.ini");
   const std::string own = params::fingerprint(car_envelope(s.vehicle));
 
+  // 70 entries of other builds, older than what the run writes: the 64
+  // latest entries are kept, the new one among them
+  fs::create_directories(dir);
+  for (int i = 0; i < 70; ++i) {
+    const std::string old = dir + "/car-envelope-old" + std::to_string(i) + ".ini";
+    write_file_atomic(old, "[cache]\nbuild = another\n");
+    fs::last_write_time(old, fs::file_time_type::clock::now() - std::chrono::hours(1000 - i));
+  }
+  write_file_atomic(dir + "/notes.txt", "not an entry: left alone\n");
   EXPECT_EQ(params::fingerprint(kept_car_envelope(s.vehicle)), own);  // measured and kept
+  EXPECT_EQ(files_in(dir).size(), 65u);
+  EXPECT_FALSE(fs::exists(dir + "/car-envelope-old6.ini"));  // the oldest seven are gone
+  EXPECT_TRUE(fs::exists(dir + "/car-envelope-old7.ini"));
+  for (int i = 0; i < 70; ++i) fs::remove(dir + "/car-envelope-old" + std::to_string(i) + ".ini");
+  fs::remove(dir + "/notes.txt");
   const std::vector<fs::path> kept = files_in(dir);
   ASSERT_EQ(kept.size(), 1u);
   const std::string text = read_file(kept[0].string());
