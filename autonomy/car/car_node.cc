@@ -25,6 +25,7 @@ void CarNode::lidar_packet(TimeNs received, const std::uint8_t* data, std::size_
   ++counters_.lidar_packets;
   last_lidar_ = received;
   if (!lidar_) return;
+  const StageScope scope(profile_, Stage::Lidar);
   lidar_->push(data, size);
   while (std::optional<hal::LidarScan> s = lidar_->pop()) inbox_.messages.push_back(std::move(*s));
 }

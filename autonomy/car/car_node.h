@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "autonomy/common/params.h"
+#include "autonomy/common/profile.h"
 #include "autonomy/hal/car_can.h"
 #include "autonomy/hal/dbc.h"
 #include "autonomy/hal/hal.h"
@@ -74,6 +75,12 @@ class CarNode {
   hal::CanFrame command_frame(const hal::ActuatorCommand& c);
 
   const stack::Stack& stack() const { return stack_; }
+  // where the time goes, timed into `profile` from now on (null: not
+  // timed): the stack's stages, and the LiDAR's decoding as Stage::Lidar
+  void set_profile(Profile* profile) {
+    profile_ = profile;
+    stack_.set_profile(profile);
+  }
   CarCounters counters() const;
   // why a watchdog fired, if one did
   const std::optional<std::string>& watchdog_fault() const { return watchdog_fault_; }
@@ -99,6 +106,7 @@ class CarNode {
   std::optional<std::string> watchdog_fault_;
   std::string last_bad_object_;
   CarCounters counters_;
+  Profile* profile_ = nullptr;
 };
 
 }  // namespace paddock::car

@@ -56,10 +56,12 @@ const char* kUsage =
     "  paddock bench-compare OLD.json NEW.json   (./paddock bench compare OLD.json NEW.json)\n"
     "      two runs of the benchmarks (./paddock bench --json FILE) side by side: each\n"
     "      one's CPU time per iteration and NEW/OLD, SLOWER past 1.10 (then exit 1)\n"
-    "  paddock replay LOG.mcap [--set section.key=value]... [--from S] [--until S]\n"
+    "  paddock replay LOG.mcap [--set section.key=value]... [--from S] [--until S] [--profile]\n"
     "      reruns the stack on a run's log (paddock run ... --log) without the simulator:\n"
     "      the recorded packets and frames through the car's decoders. Unchanged it gives\n"
     "      the live run's commands bit for bit; with --set it says where they differ.\n"
+    "      --profile prints where the wall time went, by stage (logging: reading the\n"
+    "      log; lidar: decoding its packets; the stack's stages as in a run).\n"
     "  paddock car SCENARIO.ini [--set section.key=value]... [--log] [--out DIR]\n"
     "      the car binary: the scenario's stack alone behind the car's sockets ([car]:\n"
     "      the LiDAR's UDP packets, the CAN bus by SocketCAN or CAN over UDP, the\n"
@@ -509,6 +511,7 @@ int cmd_replay(const std::vector<std::string>& args) {
     else if (a.rfind("--set=", 0) == 0) o.overrides.push_back(a.substr(6));
     else if (a == "--from") o.from = seconds("--from");
     else if (a == "--until") o.until = seconds("--until");
+    else if (a == "--profile") o.profile = true;
     else if (!a.empty() && a[0] == '-') throw UserError("unknown option " + a + "\n" + kUsage);
     else if (log_path.empty()) log_path = a;
     else throw UserError("more than one log given: " + log_path + " and " + a);

@@ -22,6 +22,7 @@
 #include "sim/runner/files.h"
 #include "sim/runner/ini.h"
 #include "sim/runner/model.h"
+#include "sim/runner/report.h"
 #include "sim/runner/scenario.h"
 #include "sim/world/track.h"
 
@@ -109,6 +110,9 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
   }
 
   ReplayResult r;
+  Profile profile;
+  Profile* const timing = o.profile ? &profile : nullptr;
+  node.set_profile(timing);
   // the control cycles: where the log has the stack's commands, at their
   // instants (the live run's cycles, on any clock), each compared with its
   // command; else (the stack ran elsewhere) every control period
@@ -152,7 +156,8 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
     ro.start = static_cast<std::uint64_t>(from);
     log::McapReader::Messages messages = reader.messages(ro);
     log::Message m;
-    while (messages.next(m)) {
+    if (timing) timing->start();
+    while (timed(timing, Stage::Logging, [&] { return messages.next(m); })) {
       const auto at = static_cast<TimeNs>(m.log_time);
       if (at > until) break;
       // the period's cycles before this message
@@ -199,6 +204,10 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
     if (!by_commands) {
       for (; tick <= from_seconds(r.log_time) && tick <= until; tick += period) cycle(tick, nullptr);
     }
+    if (timing) {
+      timing->stop();
+      r.profile = profile;
+    }
   } catch (const log::McapError& e) {
     throw UserError(path + ": " + e.what());
   } catch (const json::exception& e) {
@@ -237,6 +246,7 @@ std::string replay_text(const std::string& path, const ReplayResult& r) {
   std::snprintf(buf, sizeof buf, "  speed       %.1f s of log in %.3f s (%.0fx real time)\n", r.log_time, r.wall_time,
                 r.wall_time > 0 ? r.log_time / r.wall_time : 0.0);
   o << buf;
+  if (r.profile) o << "\nwhere the wall time went (--profile):\n" << profile_table(*r.profile, r.log_time);
   return o.str();
 }
 

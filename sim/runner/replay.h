@@ -15,12 +15,15 @@
 #include <string>
 #include <vector>
 
+#include "autonomy/common/profile.h"
+
 namespace paddock::runner {
 
 struct ReplayOptions {
   std::vector<std::string> overrides;  // --set section.key=value (the stack's keys)
   std::optional<double> from;          // s: the stack starts here (fresh), the log before it unread
   std::optional<double> until;         // s: stops here
+  bool profile = false;                // --profile: where the wall time went, by stage
 };
 
 struct ReplayResult {
@@ -37,6 +40,9 @@ struct ReplayResult {
   long lidar_scans = 0, can_frames = 0, struct_messages = 0;
   double log_time = 0.0;   // s of log replayed
   double wall_time = 0.0;  // s
+  // by stage (--profile): reading the log as logging, the LiDAR's decoding
+  // as lidar, the stack's own stages as in a run
+  std::optional<Profile> profile;
 };
 
 // replays `path`; throws UserError for a file that is no paddock log (or a

@@ -279,30 +279,37 @@ nlohmann::json slam_json(const Scenario& s, const SlamMetrics& m) {
 }
 }  // namespace
 
-std::string profile_text(const RunResult& r) {
+std::string profile_table(const Profile& p, double sim_time) {
   // the stages by their share, largest first; per simulated second the
   // wall milliseconds each costs (its share of the real-time factor) and,
   // where counted, the allocations it makes
   std::vector<Stage> order;
   for (std::size_t i = 0; i < kStageCount; ++i) order.push_back(static_cast<Stage>(i));
-  std::stable_sort(order.begin(), order.end(),
-                   [&r](Stage a, Stage b) { return r.profile.seconds(a) > r.profile.seconds(b); });
-  const double total = r.profile.total();
-  const bool counted = r.profile.counts_allocations();
-  const auto per_s = [&r](double x) { return r.sim_time > 0 ? x / r.sim_time : 0.0; };
+  std::stable_sort(order.begin(), order.end(), [&p](Stage a, Stage b) { return p.seconds(a) > p.seconds(b); });
+  const double total = p.total();
+  const bool counted = p.counts_allocations();
+  const auto per_s = [sim_time](double x) { return sim_time > 0 ? x / sim_time : 0.0; };
   std::ostringstream o;
   o << "| stage | wall s | share | ms per simulated s |" << (counted ? " allocations per simulated s |" : "")
     << "\n|---|---:|---:|---:|" << (counted ? "---:|" : "") << "\n";
   for (Stage st : order) {
-    const double sec = r.profile.seconds(st);
+    const double sec = p.seconds(st);
     o << "| " << stage_name(st) << " | " << fixed(sec, 3) << " | " << fixed(total > 0 ? 100.0 * sec / total : 0.0, 1)
       << " % | " << fixed(1000.0 * per_s(sec), 2) << " |";
-    if (counted) o << " " << fixed(per_s(static_cast<double>(r.profile.allocations(st))), 0) << " |";
+    if (counted) o << " " << fixed(per_s(static_cast<double>(p.allocations(st))), 0) << " |";
     o << "\n";
   }
   o << "| total | " << fixed(total, 3) << " | 100.0 % | " << fixed(1000.0 * per_s(total), 2) << " |";
-  if (counted) o << " " << fixed(per_s(static_cast<double>(r.profile.total_allocations())), 0) << " |";
+  if (counted) o << " " << fixed(per_s(static_cast<double>(p.total_allocations())), 0) << " |";
   o << "\n";
+  return o.str();
+}
+
+std::string profile_text(const RunResult& r) {
+  std::ostringstream o;
+  o << profile_table(r.profile, r.sim_time);
+  const bool counted = r.profile.counts_allocations();
+  const auto per_s = [&r](double x) { return r.sim_time > 0 ? x / r.sim_time : 0.0; };
   o << "page faults " << r.page_faults << " in the loop (" << fixed(per_s(static_cast<double>(r.page_faults)), 0)
     << " per simulated s)";
   if (counted) o << ", allocations " << r.profile.total_allocations();

@@ -19,8 +19,11 @@ std::string summary_text(const Scenario& s, const RunResult& r, const std::vecto
 // one JSON object (schema in the README)
 std::string summary_json(const Scenario& s, const RunResult& r, const std::vector<std::string>& failed);
 
-// `run --profile`: the run's wall time by stage (profile.h) as a Markdown
-// table, the largest first: seconds, share, milliseconds per simulated second
+// a profile (profile.h) as a Markdown table, the largest stage first:
+// seconds, share, milliseconds per simulated second (of sim_time s)
+std::string profile_table(const Profile& p, double sim_time);
+// `run --profile`: the run's wall time by stage as profile_table, then the
+// loop's page faults, allocations and peak memory
 std::string profile_text(const RunResult& r);
 
 // the stack's last plan and map (plan.json): the map's optional layers

@@ -96,9 +96,12 @@ TEST(RunLog, TheReplayGivesTheLiveRunsCommandsBitForBit) {
   ASSERT_EQ(changed.code, 0) << changed.output;
   // (the go: 5 s after the car showed AS Ready at 0.5 s)
   EXPECT_NE(changed.output.find("the first difference at 5.500 s"), std::string::npos) << changed.output;
-  // a window: the first 6 s only
-  const testing::Outcome head = testing::run_paddock("replay " + log.string() + " --until 6");
+  // a window: the first 6 s only, profiled (the same commands)
+  const testing::Outcome head = testing::run_paddock("replay " + log.string() + " --until 6 --profile");
   EXPECT_NE(head.output.find("601 compared with the log: all identical"), std::string::npos) << head.output;
+  EXPECT_NE(head.output.find("where the wall time went (--profile):"), std::string::npos) << head.output;
+  for (const char* stage : {"| logging |", "| lidar |", "| perception |", "| localisation |", "| planning |", "| total |"})
+    EXPECT_NE(head.output.find(stage), std::string::npos) << stage << "\n" << head.output;
 }
 
 TEST(RunLog, ALogNeedsTheWireAndAReplayNeedsALog) {
