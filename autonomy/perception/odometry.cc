@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace paddock::perception {
 
@@ -10,7 +11,29 @@ namespace {
 // sin(h) / h, its Taylor series near 0
 double sinc(double h) { return std::abs(h) < 1e-6 ? 1.0 - h * h / 6.0 : std::sin(h) / h; }
 
+// the same bits (0.0 and -0.0 differ, as two NaNs of one pattern do not)
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
 }  // namespace
+
+bool Odometry::same_state(const Odometry& o) const {
+  const OdometryParams& p = params_;
+  const OdometryParams& q = o.params_;
+  if (!same_bits(p.wheel_radius, q.wheel_radius) || !same_bits(p.history, q.history) ||
+      !same_bits(p.extrapolation, q.extrapolation) || p.lateral_velocity != q.lateral_velocity)
+    return false;
+  if (has_v_ != o.has_v_ || has_w_ != o.has_w_ || any_ != o.any_ || newest_ != o.newest_ || !same_bits(v_, o.v_) ||
+      !same_bits(w_, o.w_) || !same_bits(u_, o.u_) || knots_.size() != o.knots_.size())
+    return false;
+  for (std::size_t i = 0; i < knots_.size(); ++i) {
+    const Knot& a = knots_[i];
+    const Knot& b = o.knots_[i];
+    if (a.stamp != b.stamp || !same_bits(a.pose.x, b.pose.x) || !same_bits(a.pose.y, b.pose.y) ||
+        !same_bits(a.pose.yaw, b.pose.yaw) || !same_bits(a.v, b.v) || !same_bits(a.w, b.w) || !same_bits(a.u, b.u))
+      return false;
+  }
+  return true;
+}
 
 Odometry::Odometry(const OdometryParams& params) : params_(params) {
   params::require_valid(params_, "OdometryParams");

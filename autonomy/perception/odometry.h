@@ -104,6 +104,9 @@ class Odometry {
   std::optional<Pose2> pose_at(TimeNs t) const;
 
   std::size_t rejected() const { return rejected_; }
+  // the same params and state, bit for bit (the counts of rejected messages
+  // aside): every question to either has the same answer
+  bool same_state(const Odometry& other) const;
   const OdometryParams& params() const { return params_; }
 
  private:

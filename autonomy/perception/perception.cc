@@ -39,7 +39,8 @@ void Perception::add(const hal::CameraFrame& frame) {
 
 const hal::ConeDetections& Perception::process(const hal::LidarScan& scan) {
   ++stats_.scans;
-  last_.lidar = pipeline_.process(scan, &odometry_);
+  std::optional<LidarResult> ahead = ahead_ ? ahead_->take(scan, odometry_) : std::nullopt;
+  last_.lidar = ahead ? std::move(*ahead) : pipeline_.process(scan, &odometry_);
   last_.camera_used = false;
   last_.camera_note.clear();
   last_.camera_stamp = 0;

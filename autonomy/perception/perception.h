@@ -80,6 +80,19 @@ struct PerceptionStats {
   long dropped_by_fusion = 0;     // candidates dropped as false detections
 };
 
+// the LiDAR pipeline's result on a scan, computed ahead of the stack
+// elsewhere (a replay's second thread, sim/runner/read_ahead.h). Perception
+// takes it in place of its own run of the pipeline only when it was computed
+// on exactly its own inputs, so the result is the same either way
+class LidarAhead {
+ public:
+  virtual ~LidarAhead() = default;
+  // LidarPipeline(params).process(scan, &odometry)'s result, if one was
+  // computed with the perception's LiDAR params on the same scan and an
+  // odometry in the same state, bit for bit; else none
+  virtual std::optional<LidarResult> take(const hal::LidarScan& scan, const Odometry& odometry) = 0;
+};
+
 class Perception {
  public:
   // throws std::invalid_argument when params::validate(params) fails. detector: a
@@ -103,8 +116,17 @@ class Perception {
   // one rotation -> the cones, base frame at the scan's reference time (its end)
   const hal::ConeDetections& process(const hal::LidarScan& scan);
 
-  // keep the labelled points of the next scans (for plots)
-  void set_keep_points(bool keep) { params_.lidar.keep_points = keep; pipeline_ = LidarPipeline(params_.lidar); }
+  // keep the labelled points of the next scans (for plots); results
+  // computed ahead (with the former params) are no longer taken
+  void set_keep_points(bool keep) {
+    params_.lidar.keep_points = keep;
+    pipeline_ = LidarPipeline(params_.lidar);
+    ahead_ = nullptr;
+  }
+  // the LiDAR pipeline's results computed ahead (null: none), asked first
+  // for each scan; it must outlive its use here
+  void set_ahead(LidarAhead* ahead) { ahead_ = ahead; }
+  const PerceptionParams& params() const { return params_; }
   const PerceptionFrame& last() const { return last_; }
   const PerceptionStats& stats() const { return stats_; }
 
@@ -121,6 +143,7 @@ class Perception {
   std::unique_ptr<ConeDetector> detector_;
   std::optional<CameraInput> camera_;
   bool camera_distrusted_ = false;
+  LidarAhead* ahead_ = nullptr;
   PerceptionFrame last_;
   PerceptionStats stats_;
 };

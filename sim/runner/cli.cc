@@ -57,11 +57,15 @@ const char* kUsage =
     "      two runs of the benchmarks (./paddock bench --json FILE) side by side: each\n"
     "      one's CPU time per iteration and NEW/OLD, SLOWER past 1.10 (then exit 1)\n"
     "  paddock replay LOG.mcap [--set section.key=value]... [--from S] [--until S] [--profile]\n"
+    "                [--threads N]\n"
     "      reruns the stack on a run's log (paddock run ... --log) without the simulator:\n"
     "      the recorded packets and frames through the car's decoders. Unchanged it gives\n"
     "      the live run's commands bit for bit; with --set it says where they differ.\n"
     "      --profile prints where the wall time went, by stage (logging: reading the\n"
     "      log; lidar: decoding its packets; the stack's stages as in a run).\n"
+    "      --threads 2 reads the log, and runs the LiDAR pipeline on its scans, on a\n"
+    "      second thread, the same result (the stack takes a scan's result only when\n"
+    "      it was computed on its own inputs, bit for bit).\n"
     "  paddock car SCENARIO.ini [--set section.key=value]... [--log] [--out DIR]\n"
     "      the car binary: the scenario's stack alone behind the car's sockets ([car]:\n"
     "      the LiDAR's UDP packets, the CAN bus by SocketCAN or CAN over UDP, the\n"
@@ -512,6 +516,7 @@ int cmd_replay(const std::vector<std::string>& args) {
     else if (a == "--from") o.from = seconds("--from");
     else if (a == "--until") o.until = seconds("--until");
     else if (a == "--profile") o.profile = true;
+    else if (a == "--threads") o.threads = option_int("--threads", value("--threads"), 1, Workers::kMaxThreads);
     else if (!a.empty() && a[0] == '-') throw UserError("unknown option " + a + "\n" + kUsage);
     else if (log_path.empty()) log_path = a;
     else throw UserError("more than one log given: " + log_path + " and " + a);

@@ -24,6 +24,9 @@ struct ReplayOptions {
   std::optional<double> from;          // s: the stack starts here (fresh), the log before it unread
   std::optional<double> until;         // s: stops here
   bool profile = false;                // --profile: where the wall time went, by stage
+  // --threads N: 2 or more reads the log, and runs the LiDAR pipeline on
+  // its scans, on a second thread (car/read_ahead.h: the same result)
+  int threads = 1;
 };
 
 struct ReplayResult {
@@ -38,6 +41,9 @@ struct ReplayResult {
   std::string final_as_state;              // the replayed stack's at the end
   std::string watchdog_fault;              // why a watchdog of the car fired, if one did
   long lidar_scans = 0, can_frames = 0, struct_messages = 0;
+  // --threads 2: the scans whose LiDAR pipeline the second thread ran (and
+  // the stack took), and those the stack ran itself
+  long scans_ahead = 0, scans_not_ahead = 0;
   double log_time = 0.0;   // s of log replayed
   double wall_time = 0.0;  // s
   // by stage (--profile): reading the log as logging, the LiDAR's decoding

@@ -125,5 +125,34 @@ TEST(OdometryTest, ValidateNamesTheField) {
   EXPECT_EQ(params::validate(p), "history must be > 0 s (got nan)");
 }
 
+// same_state: two odometries fed the same messages answer alike, and are
+// the same; one more message, another value's sign, or other params: not
+TEST(OdometryTest, SameStateIsTheSameMessagesAndParams) {
+  Odometry a, b;
+  feed(a, 10.0, 0.5, 0, 1'000'000'000);
+  feed(b, 10.0, 0.5, 0, 1'000'000'000);
+  EXPECT_TRUE(a.same_state(b));
+  Odometry c = a;
+  EXPECT_TRUE(c.same_state(a));
+  c.add(hal::Imu{1'002'000'000, 0.0, 0.0, 0.5});
+  EXPECT_FALSE(c.same_state(a));
+  EXPECT_FALSE(a.same_state(c));
+  // a yaw rate of -0.0 against 0.0: equal as numbers, not as bits
+  Odometry z0, z1;
+  z0.add(hal::Imu{0, 0.0, 0.0, 0.0});
+  z1.add(hal::Imu{0, 0.0, 0.0, -0.0});
+  EXPECT_FALSE(z0.same_state(z1));
+  OdometryParams longer;
+  longer.history = 3.0;
+  Odometry d(longer);
+  feed(d, 10.0, 0.5, 0, 1'000'000'000);
+  EXPECT_FALSE(d.same_state(a));
+  // a rejected message leaves the state alone
+  Odometry e = a;
+  e.add(hal::Imu{500'000'000, 0.0, 0.0, std::numeric_limits<double>::quiet_NaN()});
+  EXPECT_EQ(e.rejected(), a.rejected() + 1);
+  EXPECT_TRUE(e.same_state(a));
+}
+
 }  // namespace
 }  // namespace paddock::perception

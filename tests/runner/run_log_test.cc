@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -91,6 +92,17 @@ TEST(RunLog, TheReplayGivesTheLiveRunsCommandsBitForBit) {
   EXPECT_NE(same.output.find("compared with the log: all identical, bit for bit"), std::string::npos)
       << same.output;
   EXPECT_NE(same.output.find("final AS state driving"), std::string::npos) << same.output;
+  // on two threads (the log read, and the LiDAR pipeline run, ahead of the
+  // stack): the same commands, every scan's pipeline run on one or the other
+  const testing::Outcome two = testing::run_paddock("replay " + log.string() + " --threads 2");
+  ASSERT_EQ(two.code, 0) << two.output;
+  EXPECT_NE(two.output.find("compared with the log: all identical, bit for bit"), std::string::npos) << two.output;
+  std::smatch scans, split;
+  ASSERT_TRUE(std::regex_search(two.output, scans, std::regex(R"(s: (\d+) LiDAR scans)"))) << two.output;
+  ASSERT_TRUE(std::regex_search(two.output, split,
+                                std::regex(R"(the LiDAR pipeline of (\d+) scans ran ahead on the second thread, (\d+) on)"))) << two.output;
+  EXPECT_GT(std::stol(scans[1]), 50);
+  EXPECT_EQ(std::stol(split[1]) + std::stol(split[2]), std::stol(scans[1])) << two.output;
   // a changed stack on the same log: it steers otherwise from the go on
   const testing::Outcome changed = testing::run_paddock("replay " + log.string() + " --set control.stanley.k=3");
   ASSERT_EQ(changed.code, 0) << changed.output;
