@@ -162,6 +162,15 @@ void CarLog::image(TimeNs at, const hal::CameraFrame& frame, int quality) {
   });
 }
 
+void CarLog::image(TimeNs at, hal::FrameLease frame, int quality) {
+  worker_->post([this, at, frame = std::move(frame), quality]() mutable {
+    const std::vector<std::uint8_t> jpeg = hal::encode_jpeg(*frame, quality);
+    fg::compressed_image(frame->stamp, "camera", jpeg.data(), jpeg.size(), "jpeg", text_);
+    write_now(image_, at, text_);
+    frame = hal::FrameLease();  // let go of it as soon as it is encoded
+  });
+}
+
 void CarLog::cycle(TimeNs at, const hal::ActuatorCommand& c, const stack::Stack& stack) {
   // what is due is decided here, from the stack as it is now; the messages
   // are made on the log's thread from copies

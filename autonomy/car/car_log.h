@@ -32,6 +32,7 @@
 
 #include "autonomy/common/serial_worker.h"
 #include "autonomy/hal/messages.h"
+#include "autonomy/hal/shared_frame.h"
 #include "autonomy/hal/ouster.h"
 #include "autonomy/log/mcap.h"
 #include "autonomy/stack/stack.h"
@@ -71,6 +72,9 @@ class CarLog {
   void image(TimeNs at, TimeNs stamp, const std::vector<std::uint8_t>& jpeg);
   // the same from its pixels, encoded as JPEG of this quality (on the log's thread)
   void image(TimeNs at, const hal::CameraFrame& frame, int quality);
+  // the same from a frame lent by its writer (hal/shared_frame.h): no copy,
+  // the lease held until the log's thread has encoded it
+  void image(TimeNs at, hal::FrameLease frame, int quality);
   // the control cycle at `at`: the command the stack sent, and what it made
   // of the world (its estimate, map and path); hands the cycle's messages
   // to the log's thread

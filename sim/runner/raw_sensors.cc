@@ -97,8 +97,10 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
   // none, as a node that fails posts nothing)
   std::optional<sensors::AnnotationDetection> detection;
   const auto shoot = [&] {
-    camera_->render(*world_, poses.at(exposure), exposure, frame_, annotation_);
-    detection = detector_->detect(frame_, annotation_);
+    // (a frame the log still encodes is left to it)
+    hal::CameraFrame& frame = hal::writable(frame_).frame;
+    camera_->render(*world_, poses.at(exposure), exposure, frame, annotation_);
+    detection = detector_->detect(frame, annotation_);
   };
   std::vector<sensors::LidarPoint> raw;
   const auto cast = [&] { raw = lidar_.scan(*world_, [&poses](TimeNs at) { return poses.at(at); }, start); };

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "autonomy/common/profile.h"
+#include "autonomy/hal/shared_frame.h"
 #include "autonomy/common/workers.h"
 #include "autonomy/hal/messages.h"
 #include "sim/runner/faults.h"
@@ -75,7 +76,12 @@ class RawSensors {
   // the stamp of the scan's last column (the scan's `end`) for a rotation ending at `now`
   TimeNs scan_end(TimeNs now) const;
   // the last camera frame rendered (for the perception figures), or null
-  const hal::CameraFrame* camera_frame() const { return camera_ && frame_.width > 0 ? &frame_ : nullptr; }
+  const hal::CameraFrame* camera_frame() const {
+    return camera_ && frame_->frame.width > 0 ? &frame_->frame : nullptr;
+  }
+  // the same frame lent to a reader on another thread (the log's), without
+  // a copy: the next render goes into a new frame while the lease is out
+  hal::FrameLease lend_camera_frame() const { return hal::FrameLease(frame_); }
   // the LiDAR's and the camera's time, timed into `profile` (null: not timed).
   // With two threads the camera's is the time the loop waits for it beyond
   // the LiDAR's cast
@@ -94,7 +100,7 @@ class RawSensors {
   sensors::Lidar lidar_;
   std::unique_ptr<sensors::Camera> camera_;
   std::unique_ptr<sensors::AnnotationDetector> detector_;
-  hal::CameraFrame frame_;
+  std::shared_ptr<hal::SharedFrame> frame_ = std::make_shared<hal::SharedFrame>();
   std::optional<hal::CameraDetections> frozen_;  // a frozen camera's last detections
   sensors::CameraAnnotation annotation_;
   sensors::GroundParams ground_;

@@ -56,7 +56,7 @@ void RunLog::observe(const SimModel& model, SimState& s) {
   // the camera's frames, as the car logs them
   if (const hal::CameraFrame* f = s.raw ? s.raw->camera_frame() : nullptr; f && f->stamp != last_image_) {
     last_image_ = f->stamp;
-    log_->image(at, *f, kJpegQuality);
+    log_->image(at, s.raw->lend_camera_frame(), kJpegQuality);
   }
   // what was true: the pose at the log rate, the cones once a second
   if (s.k % log_every_ == 0) {

@@ -41,8 +41,12 @@ TEST(CarLog, ItsThreadWritesTheSameBytesAsTheCaller) {
   const std::string dir = (std::filesystem::temp_directory_path() / "paddock_car_log_test").string();
   std::filesystem::create_directories(dir);
   std::vector<std::string> files;
-  for (const bool threaded : {false, true}) {
-    const std::string path = dir + (threaded ? "/threaded.mcap" : "/caller.mcap");
+  // on the caller's thread; on the log's; on the log's with the frames lent
+  // (hal::FrameLease), each rewritten while the log may still encode it
+  for (const int variant : {0, 1, 2}) {
+    const bool threaded = variant > 0, lent = variant == 2;
+    const std::string path = dir + "/variant" + std::to_string(variant) + ".mcap";
+    auto shared = std::make_shared<hal::SharedFrame>();
     CarLog log(path, {{"note.txt", "text/plain", "hello"}}, {{"k", "v"}}, info, layout, 50'000'000, threaded);
     const std::uint16_t own = log.channel("/own", "", "text");
     const TimeNs rotation = 100'000'000;
@@ -69,12 +73,14 @@ TEST(CarLog, ItsThreadWritesTheSameBytesAsTheCaller) {
         log.cycle(t, command, node.stack());
         log.write(own, t, "cycle " + std::to_string(c));
       }
-      hal::CameraFrame f;
+      hal::CameraFrame& f = hal::writable(shared).frame;
+      f.rgb.clear();
       f.stamp = r * rotation;
       f.width = 64;
       f.height = 48;
       for (int p = 0; p < f.width * f.height * 3; ++p) f.rgb.push_back(static_cast<std::uint8_t>((p * 7 + r) % 256));
-      log.image(r * rotation + 1, f, 85);
+      if (lent) log.image(r * rotation + 1, hal::FrameLease(shared), 85);
+      else log.image(r * rotation + 1, f, 85);
       log.image(r * rotation + 2, f.stamp, std::vector<std::uint8_t>{0xFF, 0xD8, 0xFF, 0xD9});
       hal::CameraDetections d;
       d.stamp = r * rotation;
@@ -89,6 +95,8 @@ TEST(CarLog, ItsThreadWritesTheSameBytesAsTheCaller) {
   ASSERT_GT(files[0].size(), 100'000u);  // the packets, two clouds, the images are in
   EXPECT_TRUE(files[0] == files[1]) << "the threaded log differs from the caller's (" << files[0].size() << " and "
                                     << files[1].size() << " bytes)";
+  EXPECT_TRUE(files[0] == files[2]) << "the log of lent frames differs from the caller's (" << files[0].size()
+                                    << " and " << files[2].size() << " bytes)";
 }
 
 }  // namespace
