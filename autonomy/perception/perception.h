@@ -81,7 +81,7 @@ struct PerceptionStats {
 };
 
 // the LiDAR pipeline's result on a scan, computed ahead of the stack
-// elsewhere (a replay's second thread, sim/runner/read_ahead.h). Perception
+// elsewhere (a replay's second thread, car/read_ahead.h). Perception
 // takes it in place of its own run of the pipeline only when it was computed
 // on exactly its own inputs, so the result is the same either way
 class LidarAhead {
