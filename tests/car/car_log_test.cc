@@ -15,17 +15,13 @@
 #include "autonomy/car/car_node.h"
 #include "autonomy/hal/dbc.h"
 #include "autonomy/hal/ouster.h"
+#include "tests/car/shipped_files.h"
 
 namespace paddock::car {
 namespace {
 
-std::string read(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-std::string shipped(const std::string& name) { return read(std::string(PADDOCK_SOURCE_DIR) + "/scenarios/sensors/" + name); }
+using testing::read;
+using testing::shipped;
 
 TEST(CarLog, ItsThreadWritesTheSameBytesAsTheCaller) {
   const hal::ouster::SensorInfo info = hal::ouster::parse_sensor_info(shipped("os2_32.json"), "os2_32.json");

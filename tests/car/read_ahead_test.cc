@@ -20,19 +20,15 @@
 #include "autonomy/car/car_log.h"
 #include "autonomy/hal/dbc.h"
 #include "autonomy/hal/ouster.h"
+#include "tests/car/shipped_files.h"
 
 namespace paddock::car {
 namespace {
 
 namespace fs = std::filesystem;
 
-std::string read(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-std::string shipped(const std::string& name) { return read(std::string(PADDOCK_SOURCE_DIR) + "/scenarios/sensors/" + name); }
+using testing::read;
+using testing::shipped;
 
 struct Owned {
   std::uint16_t channel = 0;
