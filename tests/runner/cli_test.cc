@@ -67,6 +67,12 @@ TEST(Cli, ThreadsMustBeAWholeNumberInRange) {
   const auto o = paddock("run " + kRoot + "/scenarios/acceleration.ini --threads");
   EXPECT_EQ(o.code, 2);
   EXPECT_THAT(o.output, HasSubstr("--threads needs a value"));
+  // the replay's likewise (checked before the log is read)
+  for (const char* bad : {"0", "65", "two"}) {
+    const auto r = paddock("replay " + scratch("no_such.mcap") + " --threads '" + bad + "'");
+    EXPECT_EQ(r.code, 2) << bad;
+    EXPECT_THAT(r.output, HasSubstr("--threads " + std::string(bad) + ": expected a whole number from 1 to 64"));
+  }
 }
 
 TEST(Cli, MissingScenarioFileIsNamed) {
