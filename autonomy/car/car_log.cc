@@ -155,11 +155,10 @@ void CarLog::image(TimeNs at, TimeNs stamp, const std::vector<std::uint8_t>& jpe
 }
 
 void CarLog::image(TimeNs at, const hal::CameraFrame& frame, int quality) {
-  worker_->post([this, at, frame, quality] {
-    const std::vector<std::uint8_t> jpeg = hal::encode_jpeg(frame, quality);
-    fg::compressed_image(frame.stamp, "camera", jpeg.data(), jpeg.size(), "jpeg", text_);
-    write_now(image_, at, text_);
-  });
+  // a copy, lent to the log's thread as a writer's frame is
+  auto copy = std::make_shared<hal::SharedFrame>();
+  copy->frame = frame;
+  image(at, hal::FrameLease(std::move(copy)), quality);
 }
 
 void CarLog::image(TimeNs at, hal::FrameLease frame, int quality) {

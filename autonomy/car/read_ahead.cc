@@ -1,15 +1,14 @@
 #include "autonomy/car/read_ahead.h"
 
 #include <algorithm>
-#include <cstring>
 #include <utility>
 #include <variant>
+
+#include "autonomy/common/same_bits.h"
 
 namespace paddock::car {
 
 namespace {
-
-bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // the same rotation, bit for bit
 bool same_scan(const hal::LidarScan& a, const hal::LidarScan& b) {

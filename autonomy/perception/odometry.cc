@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
+
+#include "autonomy/common/same_bits.h"
 
 namespace paddock::perception {
 
@@ -10,9 +11,6 @@ namespace {
 
 // sin(h) / h, its Taylor series near 0
 double sinc(double h) { return std::abs(h) < 1e-6 ? 1.0 - h * h / 6.0 : std::sin(h) / h; }
-
-// the same bits (0.0 and -0.0 differ, as two NaNs of one pattern do not)
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 }  // namespace
 
@@ -114,10 +112,9 @@ std::optional<Pose2> Odometry::pose_at(TimeNs t) const {
 }
 
 std::optional<Pose2> Odometry::relative(TimeNs from, TimeNs to) const {
-  const std::optional<Pose2> a = pose_at(from), b = pose_at(to);
-  if (!a || !b) return std::nullopt;
-  const Vec2 p = a->inverse_transform(b->position());
-  return Pose2{p.x, p.y, wrap_angle(b->yaw - a->yaw)};
+  Pose2 out;
+  if (!relative(from, &to, 1, &out)) return std::nullopt;
+  return out;
 }
 
 bool Odometry::relative(TimeNs from, const TimeNs* to, std::size_t n, Pose2* out) const {

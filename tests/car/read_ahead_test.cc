@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "autonomy/car/car_log.h"
+#include "autonomy/common/same_bits.h"
 #include "autonomy/hal/dbc.h"
 #include "autonomy/hal/ouster.h"
 #include "tests/car/shipped_files.h"
@@ -35,8 +36,6 @@ struct Owned {
   std::uint64_t log_time = 0;
   std::vector<std::uint8_t> data;
 };
-
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 // two pipeline results alike in every field
 void expect_same(const perception::LidarResult& a, const perception::LidarResult& b) {
