@@ -36,13 +36,13 @@ using namespace paddock;
 void BM_DefaultScenario(benchmark::State& state) {
   std::vector<std::string> overrides;
   const auto mode = state.range(0);
-  if (mode == 5) overrides = runner::thread_overrides(2);
+  const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/scenarios/fsg_2023_trackdrive.ini";
+  if (mode == 5) overrides = runner::thread_overrides(2, runner::load_scenario(path));
   if (mode == 1 || mode == 2 || mode >= 6) overrides.push_back("autonomy.perception=ground_truth");
   if (mode == 2 || mode == 7) overrides.push_back("autonomy.planner=oracle");
   if (mode == 3) overrides.push_back("autonomy.slam=lio");
   if (mode == 4 || mode >= 6) overrides.push_back("autonomy.slam=ground_truth");
-  const runner::Scenario sc =
-      runner::load_scenario(std::string(PADDOCK_SOURCE_DIR) + "/scenarios/fsg_2023_trackdrive.ini", overrides);
+  const runner::Scenario sc = runner::load_scenario(path, overrides);
   const world::TrackModel track = world::build_track(runner::load_track_file(sc.track_path));
   runner::shared_car_envelope(sc.vehicle);  // the run reads it from here
   double sim_seconds = 0.0;

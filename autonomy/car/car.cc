@@ -273,7 +273,11 @@ void run_car(const CarSetup& s, std::ostream& out, const volatile std::sig_atomi
   if (!s.dbc) throw std::invalid_argument("run_car: the car's DBC is needed");
   const std::string problem = params::validate(s.car);
   if (!problem.empty()) throw std::invalid_argument("[car] " + problem);
-  CarNode node(s.stack, s.mission, s.lidar, s.layout, *s.dbc, s.dbc_source, s.car.watchdog);
+  // on the car's own clock the scans take the time their processing takes:
+  // no modelled latency on top ([perception] latency is the simulation's)
+  stack::StackParams stack = s.stack;
+  if (s.car.clock == Clock::Wall) stack.perception.latency = 0.0;
+  CarNode node(stack, s.mission, s.lidar, s.layout, *s.dbc, s.dbc_source, s.car.watchdog);
   hal::UdpSocket lidar(s.car.host, s.car.lidar_port);
   hal::UdpSocket objects(s.car.host, s.car.objects_port);
   std::optional<hal::UdpSocket> can_udp;

@@ -76,7 +76,7 @@ class CarNode {
 
   const stack::Stack& stack() const { return stack_; }
   // the stack's perception (perception = lidar | lidar_camera), else null
-  perception::Perception* perception() { return stack_.perception(); }
+  stack::PerceptionStage* perception() { return stack_.perception(); }
   // where the time goes, timed into `profile` from now on (null: not
   // timed): the stack's stages, and the LiDAR's decoding as Stage::Lidar
   void set_profile(Profile* profile) {

@@ -23,6 +23,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "autonomy/common/params.h"
 #include "autonomy/hal/messages.h"
@@ -48,6 +49,12 @@ struct PerceptionParams {
   // a camera frame's detections serve the scan during whose rotation the
   // frame was exposed, give or take this much
   double camera_sync_tolerance = 0.02;
+  // not Perception's own: how the stack runs it (stack/perception_stage.h).
+  // A scan's cones reach the localisation this long after the scan came
+  // (the pipeline's compute on the car), and 2 threads process the scans
+  // beside the loop (the same result)
+  double latency = 0.0;
+  int threads = 1;
 
   template <class V>
   void visit(V& v) {
@@ -56,6 +63,10 @@ struct PerceptionParams {
     v.section(PADDOCK_PARAM(fusion), "the LiDAR-camera fusion");
     v(PADDOCK_PARAM(camera_sync_tolerance), {"s", params::in(0.0, 1.0),
                                              "a camera frame serves the rotation it was exposed in, give or take this"});
+    v(PADDOCK_PARAM(latency), {"s", params::in(0.0, 1.0),
+                               "a scan's cones reach the localisation this long after the scan (the pipeline's compute on the car)"});
+    v(PADDOCK_PARAM(threads), {"", params::in(1, 2),
+                               "2: the scans are processed on a thread of their own beside the loop (the result is the same)"});
   }
   // the camera's calibration when use_camera
   std::string check() const;
@@ -128,6 +139,8 @@ class Perception {
   void set_ahead(LidarAhead* ahead) { ahead_ = ahead; }
   const PerceptionParams& params() const { return params_; }
   const PerceptionFrame& last() const { return last_; }
+  // the last frame exchanged for `other` (its buffers reused by the next scan)
+  void swap_last(PerceptionFrame& other) { std::swap(last_, other); }
   const PerceptionStats& stats() const { return stats_; }
 
  private:

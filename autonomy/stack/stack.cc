@@ -47,7 +47,7 @@ Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<percep
   if (params_.autonomy.perception != PerceptionMode::GroundTruth) {
     perception::PerceptionParams pp = params_.perception;
     pp.use_camera = params_.autonomy.perception == PerceptionMode::LidarCamera;
-    perception_ = std::make_unique<perception::Perception>(pp, std::move(detector));
+    perception_ = std::make_unique<PerceptionStage>(pp, std::move(detector));
   }
   if (params_.autonomy.slam != SlamMode::GroundTruth)
     localisation_.emplace(params_.slam, params_.autonomy.slam, spec_.start_pose);
@@ -81,10 +81,7 @@ void Stack::on_message(hal::SensorMessage&& m) {
       const StageScope scope(profile_, Stage::Localisation);
       if (const std::optional<hal::StateEstimate> e = localisation_->on_imu(*imu)) take_estimate(*e);
     }
-    if (perception_) {
-      const StageScope scope(profile_, Stage::Perception);
-      perception_->add(*imu);
-    }
+    if (perception_) perception_->add(*imu);
     return;
   }
   if (const auto* wheels = std::get_if<hal::WheelSpeeds>(&m)) {
@@ -93,10 +90,7 @@ void Stack::on_message(hal::SensorMessage&& m) {
       const StageScope scope(profile_, Stage::Localisation);
       localisation_->on_wheel_speeds(*wheels);
     }
-    if (perception_) {
-      const StageScope scope(profile_, Stage::Perception);
-      perception_->add(*wheels);
-    }
+    if (perception_) perception_->add(*wheels);
     return;
   }
   if (const auto* steering = std::get_if<hal::SteeringAngle>(&m)) {
@@ -119,25 +113,33 @@ void Stack::on_message(hal::SensorMessage&& m) {
     vcu_ = *vcu;
   } else if (!perception_) {
     // perception = ground_truth: the raw sensors' messages are not used
-  } else if (const auto* scan = std::get_if<hal::LidarScan>(&m)) {
-    // slam = lio: the scan localises the car first, its cones are then
-    // placed at the pose it gave
+  } else if (auto* scan = std::get_if<hal::LidarScan>(&m)) {
+    // the scan's job (perception_stage.h); slam = lio: the scan localises
+    // the car meanwhile, the cones are then placed at the pose it gave
     health_.lidar_scan(now_, scan->points.size());
+    const hal::LidarScan& posted =
+        timed(profile_, Stage::Perception, [&]() -> const hal::LidarScan& { return perception_->post(std::move(*scan), now_); });
     if (localisation_) {
       const StageScope scope(profile_, Stage::Localisation);
-      localisation_->on_scan(*scan);
+      localisation_->on_scan(posted);
     }
-    const hal::ConeDetections& cones =
-        timed(profile_, Stage::Perception, [&]() -> const hal::ConeDetections& { return perception_->process(*scan); });
-    const StageScope mapping(profile_, Stage::Localisation);
-    on_detections(cones);
+    // (latency 0: the cones at once)
+    deliver_perception(now_);
   } else if (auto* boxes = std::get_if<hal::CameraDetections>(&m)) {
     health_.camera(now_, *boxes, state_ ? std::hypot(state_->vx, state_->vy) : 0.0);
-    const StageScope scope(profile_, Stage::Perception);
     perception_->add(std::move(*boxes));
-  } else if (const auto* frame = std::get_if<hal::CameraFrame>(&m)) {
-    const StageScope scope(profile_, Stage::Perception);
-    perception_->add(*frame);
+  } else if (auto* frame = std::get_if<hal::CameraFrame>(&m)) {
+    perception_->add(std::move(*frame));
+  }
+}
+
+void Stack::deliver_perception(TimeNs now) {
+  for (;;) {
+    const perception::PerceptionFrame* f =
+        timed(profile_, Stage::Perception, [&] { return perception_->deliver(now); });
+    if (f == nullptr) return;
+    const StageScope mapping(profile_, Stage::Localisation);
+    on_detections(f->output);
   }
 }
 
@@ -502,6 +504,10 @@ double Stack::emergency_steering(TimeNs now, double dt) {
 void Stack::tick(TimeNs now, hal::Hal& hal) {
   now_ = now;
   while (auto m = hal.receive()) on_message(std::move(*m));
+  // the cones of the scans whose processing has taken [perception] latency
+  // by now (after this cycle's messages: a scan that came in them is on its
+  // way meanwhile)
+  if (perception_) deliver_perception(now);
   // the watchdogs and the degraded modes (health.h); a fault it cannot drive with ends in AS Emergency
   if (localisation_ && localisation_->owns_map()) health_.map_fit(localisation_->lost_run());
   health_.cycle(now, state_ ? std::hypot(state_->vx, state_->vy) : 0.0);

@@ -23,6 +23,7 @@
 #include "autonomy/stack/gates.h"
 #include "autonomy/stack/health.h"
 #include "autonomy/stack/localisation.h"
+#include "autonomy/stack/perception_stage.h"
 
 namespace paddock::stack {
 
@@ -231,9 +232,9 @@ class Stack {
   // the map the last plan was made on (its triangulation indexes these)
   const std::vector<Cone>& last_plan_cones() const { return last_plan_cones_; }
   const std::vector<Segment>& gates() const { return gates_; }
-  // perception = lidar | lidar_camera: the pipeline (its last frame, stats), else null
-  perception::Perception* perception() { return perception_.get(); }
-  const perception::Perception* perception() const { return perception_.get(); }
+  // perception = lidar | lidar_camera: the pipeline as the stack runs it
+  // (the frame it delivered last, its stats), else null
+  PerceptionStage* perception() { return perception_.get(); }
   // the last frame of cones perception delivered (base frame at its stamp) and
   // how many frames came so far: for the perception metrics
   const hal::ConeDetections& last_detections() const { return last_detections_; }
@@ -247,6 +248,8 @@ class Stack {
   // a state estimate the stack now drives on (handed in, or its own)
   void take_estimate(const hal::StateEstimate& est);
   void on_detections(const hal::ConeDetections& d);
+  // perception's frames due by now, into the map
+  void deliver_perception(TimeNs now);
   void add_to_map(const hal::ConeDetections& d);
   // the base pose at time t from the recent state estimates (interpolated), if known
   std::optional<Pose2> pose_at(TimeNs t) const;
@@ -288,7 +291,7 @@ class Stack {
   control::Controller controller_;
   Telemetry telemetry_;
   Profile* profile_ = nullptr;
-  std::unique_ptr<perception::Perception> perception_;
+  std::unique_ptr<PerceptionStage> perception_;
 
   // slam != ground_truth: the stack's own estimate, from the HAL's sensors
   std::optional<Localisation> localisation_;

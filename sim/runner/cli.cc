@@ -9,8 +9,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
-#include <tuple>
 #include <iostream>
+#include <optional>
+#include <tuple>
 
 #include "autonomy/common/format.h"
 #include "autonomy/common/workers.h"
@@ -50,8 +51,10 @@ const char* kUsage =
     "      camera, perception, localisation, planning, control, logging, scoring,\n"
     "      other; also in summary.json's \"profile\" always).\n"
     "      --threads N runs on N threads, the same result: the camera renders beside\n"
-    "      the LiDAR's cast (--set sim.threads=2) and FastSLAM's particles are split\n"
-    "      N ways (--set slam.threads=N); a sweep keeps one run per core.\n"
+    "      the LiDAR's cast (--set sim.threads=2); with a perception latency the scans\n"
+    "      are processed beside the loop (--set perception.threads=2) and FastSLAM's\n"
+    "      particles are split N - 1 ways, else N ways (--set slam.threads=N); a sweep\n"
+    "      keeps one run per core.\n"
     "      Exit 3 when [expect] fails.\n"
     "  paddock bench-compare OLD.json NEW.json   (./paddock bench compare OLD.json NEW.json)\n"
     "      two runs of the benchmarks (./paddock bench --json FILE) side by side: each\n"
@@ -185,6 +188,8 @@ int cmd_run(const std::vector<std::string>& args) {
   std::string scenario_path, out_dir;
   std::vector<std::string> overrides;
   bool json = false, quiet = false, plots = false, log = false, profile = false;
+  std::optional<int> threads;
+  std::size_t threads_at = 0;
   PlotOptions plot_options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
@@ -202,15 +207,20 @@ int cmd_run(const std::vector<std::string>& args) {
     else if (a == "--log") log = true;
     else if (a == "--profile") profile = true;
     else if (a == "--threads") {
-      // the run on N threads: the camera beside the LiDAR, FastSLAM's particles split N ways
-      const int n = option_int("--threads", value("--threads"), 1, Workers::kMaxThreads);
-      for (std::string& o : thread_overrides(n)) overrides.push_back(std::move(o));
+      // the run on N threads (thread_overrides), in the overrides' order
+      // once the scenario is known
+      threads = option_int("--threads", value("--threads"), 1, Workers::kMaxThreads);
+      threads_at = overrides.size();
     }
     else if (!a.empty() && a[0] == '-') throw UserError("unknown option " + a + "\n" + kUsage);
     else if (scenario_path.empty()) scenario_path = a;
     else throw UserError("more than one scenario given: " + scenario_path + " and " + a);
   }
   if (scenario_path.empty()) throw UserError(std::string("run needs a scenario file\n") + kUsage);
+  if (threads) {
+    const std::vector<std::string> t = thread_overrides(*threads, load_scenario(scenario_path, overrides));
+    overrides.insert(overrides.begin() + static_cast<std::ptrdiff_t>(threads_at), t.begin(), t.end());
+  }
 
   const Scenario scenario = load_scenario(scenario_path, overrides);
   std::vector<std::string> warnings;

@@ -71,7 +71,10 @@ SimModel compile_model(const Scenario& scenario, const world::TrackModel& track)
   m.every.steering = steps_per(scenario.steering_sensor.rate);
   m.every.vcu_status = sim.physics_rate / scenario.vcu.status_rate;
   m.go = from_seconds(scenario.scenario.go_time);
-  m.pose_history_span = std::max(kNsPerSecond, 2 * from_seconds(1.0 / scenario.lidar.rate));
+  // (a scan's cones are scored when perception delivers them, its latency later)
+  const TimeNs latency = from_seconds(scenario.perception.latency);
+  m.pose_history_span = std::max(kNsPerSecond, 2 * from_seconds(1.0 / scenario.lidar.rate)) + latency;
+  m.visible_scans = 4 + static_cast<std::size_t>(std::ceil(scenario.perception.latency * scenario.lidar.rate));
   return m;
 }
 

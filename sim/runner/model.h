@@ -3,6 +3,7 @@
 // scenario and its track, never written afterwards. Everything that changes
 // while the car drives lives in a SimState (simulation.h); any number of
 // states can step against one model at once, on as many threads.
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -49,7 +50,10 @@ struct SimModel {
   TimeNs dt_ns = 1000000;
   StepPeriods every;
   TimeNs go = 0;               // the go signal comes this long after the car shows AS Ready
-  TimeNs pose_history_span = 0;  // the true poses kept: a second, and two LiDAR rotations at least
+  // the true poses kept: a second, and two LiDAR rotations at least, and
+  // perception's latency more
+  TimeNs pose_history_span = 0;
+  std::size_t visible_scans = 4;  // the scans' cones hit kept for the perception metrics
 };
 
 // compiles the model of a scenario on its track; the scenario was validated by

@@ -10,9 +10,9 @@
 namespace paddock::runner {
 namespace {
 
-// frame: the camera frame the runner rendered last (the one of the scan the
-// stack just processed), or null
-PerceptionSnapshot take_snapshot(const perception::Perception& p, const hal::CameraFrame* frame, const Pose2& pose,
+// frame: the camera frame of the rotation whose scan perception delivered
+// last, or null
+PerceptionSnapshot take_snapshot(const stack::PerceptionStage& p, const hal::CameraFrame* frame, const Pose2& pose,
                                  const world::ConeWorld& cones) {
   const perception::PerceptionFrame& f = p.last();
   PerceptionSnapshot s;
@@ -83,18 +83,29 @@ void PerceptionScorer::observe(const SimModel& model, SimState& s) {
 }
 
 void SnapshotRecorder::observe(const SimModel& model, SimState& s) {
-  perception::Perception* p = s.stack.perception();
+  stack::PerceptionStage* p = s.stack.perception();
   if (!p || snapshot_) return;
   const long frames = s.stack.detection_frames();
   const bool new_frame = frames > frames_seen_;
   frames_seen_ = frames;
   const double snapshot_time = model.scenario.sim.snapshot_time;
+  // the frame of the scan delivered last: the camera's newest, or with a
+  // latency one of the frames kept since arming
+  if (armed_ && s.raw && s.raw->camera_frame() != nullptr &&
+      (frames_.empty() || frames_.back().stamp != s.raw->camera_frame()->stamp)) {
+    frames_.push_back(*s.raw->camera_frame());
+    while (frames_.size() > p->in_flight() + 2) frames_.pop_front();
+  }
   if (armed_ && new_frame && s.t >= snapshot_time) {
-    snapshot_ = take_snapshot(*p, s.raw ? s.raw->camera_frame() : nullptr, s.true_poses.at(s.stack.last_detections().stamp),
-                              s.cones);
+    const hal::CameraFrame* frame = nullptr;
+    for (const hal::CameraFrame& f : frames_)
+      if (f.stamp == p->last().camera_stamp) frame = &f;
+    snapshot_ = take_snapshot(*p, frame, s.true_poses.at(s.stack.last_detections().stamp), s.cones);
     p->set_keep_points(false);
-  } else if (!armed_ && static_cast<double>(s.k + 1) * model.dt >= snapshot_time) {
-    // perception keeps the points from the next step on
+    frames_.clear();
+  } else if (!armed_ && static_cast<double>(s.k + 1) * model.dt >= snapshot_time - p->params().latency) {
+    // perception keeps the points from the next step's scan on (delivered
+    // from the snapshot's time on)
     p->set_keep_points(true);
     armed_ = true;
   }

@@ -5,6 +5,7 @@
 // metrics and the perception snapshot are observers; so can be a live view, a
 // tuner's early stop or a test's probe.
 #include <cstdint>
+#include <deque>
 #include <optional>
 #include <vector>
 
@@ -167,6 +168,9 @@ class SnapshotRecorder final : public Observer {
  private:
   bool armed_ = false;
   long frames_seen_ = 0;
+  // once armed, the camera's frames of the scans still in perception's
+  // hands ([perception] latency), newest last
+  std::deque<hal::CameraFrame> frames_;
   std::optional<PerceptionSnapshot> snapshot_;
 };
 

@@ -173,7 +173,7 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
         setup->perception = node.perception()->params();
       }
       ahead.emplace(std::move(messages), static_cast<std::uint64_t>(until), std::move(setup));
-      if (node.perception()) node.perception()->set_ahead(&*ahead);
+      if (node.perception()) node.perception()->perception().set_ahead(&*ahead);
     }
     log::Message m;
     const auto next = [&] { return ahead ? ahead->next(m) : messages.next(m); };
@@ -230,7 +230,7 @@ ReplayResult replay(const std::string& path, const ReplayOptions& o) {
       r.profile = profile;
     }
     if (ahead) {
-      if (node.perception()) node.perception()->set_ahead(nullptr);
+      if (node.perception()) node.perception()->perception().set_ahead(nullptr);
       const car::ReadAhead::Counters c = ahead->counters();
       r.scans_ahead = static_cast<long>(c.taken);
       r.scans_not_ahead = static_cast<long>(c.not_ahead + c.mismatched);

@@ -272,8 +272,12 @@ std::string Scenario::check() const {
          " ms to integrate stably)";
 }
 
-std::vector<std::string> thread_overrides(int n) {
-  return {"sim.threads=" + std::to_string(std::min(n, SimSection::kMaxThreads)), "slam.threads=" + std::to_string(n)};
+std::vector<std::string> thread_overrides(int n, const Scenario& s) {
+  const bool perception_thread =
+      n > 1 && s.autonomy.perception != stack::PerceptionMode::GroundTruth && s.perception.latency > 0.0;
+  return {"sim.threads=" + std::to_string(std::min(n, SimSection::kMaxThreads)),
+          "perception.threads=" + std::to_string(perception_thread ? 2 : 1),
+          "slam.threads=" + std::to_string(perception_thread ? n - 1 : n)};
 }
 
 Scenario load_scenario(const std::string& path, const std::vector<std::string>& overrides) {

@@ -249,10 +249,13 @@ struct Scenario {
   std::string check() const;
 };
 
-// the overrides of a run on n threads (paddock run --threads n): the camera
-// beside the LiDAR (sim.threads, at most SimSection::kMaxThreads) and
-// FastSLAM's particles split n ways (slam.threads); the same result
-std::vector<std::string> thread_overrides(int n);
+// the overrides of a run of scenario s on n threads (paddock run --threads
+// n): the camera beside the LiDAR (sim.threads, at most
+// SimSection::kMaxThreads); when s's perception is raw and has a latency
+// (its scans' processing can then go on beside the loop), the scans on a
+// thread of their own (perception.threads = 2) and FastSLAM's particles
+// split n - 1 ways, else split n ways (slam.threads); the same result
+std::vector<std::string> thread_overrides(int n, const Scenario& s);
 
 // reads, resolves includes, applies the overrides ("section.key=value"), checks
 // every key and value; throws UserError "file:line: ..." on any problem

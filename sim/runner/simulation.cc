@@ -152,7 +152,7 @@ void run_due(const SimModel& model, SimState& s) {
   if (s.raw && s.raw->rotation_ends(s.now)) {
     const std::vector<std::int32_t>& hit = s.raw->emit(s.now, s.cones, s.true_poses, s.hal, s.faults, s.t);
     s.visible.emplace_back(s.raw->scan_end(s.now), cones_hit(hit, static_cast<std::size_t>(s.cones.cone_count())));
-    while (s.visible.size() > 4) s.visible.pop_front();
+    while (s.visible.size() > model.visible_scans) s.visible.pop_front();
   }
   measure_odometry(model, s, base);
   vcu_due(model, s);

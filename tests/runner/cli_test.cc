@@ -186,6 +186,40 @@ TEST(Cli, SameScenarioAndSeedGiveIdenticalSummaryAndLog) {
   EXPECT_TRUE(log_a.compare(0, log_c.size(), log_c) == 0) << "the resolved scenario's run differs";
 }
 
+TEST(Cli, WithAPerceptionLatencyTheScansGoOnAThreadOfTheirOwnAndTheResultStays) {
+  // the default scenario's first 20 s after the go with a rotation's latency:
+  // on one thread, and on two (the scans processed beside the loop,
+  // FastSLAM's particles on the loop's thread alone): the same log
+  const std::string scenario =
+      kRoot + "/scenarios/fsg_2023_trackdrive.ini --set event.timeout=20 --set perception.latency=0.1";
+  const auto a = paddock("run " + scenario + " --out " + scratch("lat_a"));
+  const auto b = paddock("run " + scenario + " --threads 2 --out " + scratch("lat_b"));
+  ASSERT_EQ(a.code, 0) << a.output;
+  ASSERT_EQ(b.code, 0) << b.output;
+  const std::string log_a = paddock::runner::read_file(scratch("lat_a") + "/log.csv");
+  EXPECT_GT(log_a.size(), 50000u);
+  EXPECT_TRUE(log_a == paddock::runner::read_file(scratch("lat_b") + "/log.csv"))
+      << "log.csv differs between one thread and two";
+  const std::string resolved = paddock::runner::read_file(scratch("lat_b") + "/scenario.ini");
+  // a key of a section of a resolved scenario
+  const auto key = [](const std::string& text, const std::string& section, const std::string& k) {
+    std::smatch m;
+    // the section's own lines (up to the next header) down to the key
+    const std::regex re("\\[" + section + R"(\]\n(?:[^\[\n][^\n]*\n)*?)" + k + R"( = ([^ ;\n]+))");
+    return std::regex_search(text, m, re) ? m[1].str() : std::string("?");
+  };
+  EXPECT_EQ(key(resolved, "perception", "threads"), "2");
+  EXPECT_EQ(key(resolved, "slam", "threads"), "1");
+  EXPECT_EQ(key(resolved, "sim", "threads"), "2");
+  // without the latency nothing could go on beside the loop: the particles take the second thread
+  const auto c = paddock("run " + kRoot + "/scenarios/acceleration.ini --threads 2 --out " + scratch("lat_c"));
+  ASSERT_EQ(c.code, 0) << c.output;
+  const std::string resolved_c = paddock::runner::read_file(scratch("lat_c") + "/scenario.ini");
+  EXPECT_EQ(key(resolved_c, "perception", "latency"), "0");
+  EXPECT_EQ(key(resolved_c, "perception", "threads"), "1");
+  EXPECT_EQ(key(resolved_c, "slam", "threads"), "2");
+}
+
 TEST(Cli, JsonSummaryCarriesTheSchema) {
   const auto o = paddock("run " + kRoot + "/scenarios/fsg_2019_autocross.ini --json --out " + scratch("json"));
   ASSERT_EQ(o.code, 0) << o.output;

@@ -145,6 +145,37 @@ TEST(Simulation, TwoModelsWithOtherSeedsOnTwoThreadsStayApart) {
   EXPECT_TRUE(same_rows(alone2.log, b.log));
 }
 
+TEST(Simulation, APerceptionLatencyDelaysEachFrameAndTheScansThreadChangesNothing) {
+  // each scan's cones reach the stack [perception] latency after the scan
+  // came (at its rotation's end, a column after the last column's stamp):
+  // none sooner, none later than the control cycle at that instant
+  const ScenarioOnTrack& s = default_setup();
+  for (const double latency : {0.0, 0.1, 0.25}) {
+    Scenario sc = s.scenario;
+    sc.perception.latency = latency;
+    const SimModel model = compile_model(sc, s.track);
+    SimState state(model);
+    const TimeNs column = from_seconds(1.0 / sc.lidar.rate) / sc.lidar.columns;
+    long frames = 0;
+    while (!state.done) {
+      step(model, state);
+      if (state.stack.detection_frames() == frames) continue;
+      ++frames;
+      const TimeNs late = state.now - state.stack.last_detections().stamp;
+      EXPECT_GE(late, from_seconds(latency) + column - 1) << latency << " s: frame " << frames;
+      EXPECT_LT(late, from_seconds(latency) + model.dt_ns * model.every.control) << latency << " s: frame " << frames;
+    }
+    EXPECT_GT(frames, 40) << latency;
+    // a scan on a thread of its own: the same run, bit for bit
+    if (latency == 0.0) continue;
+    const Trace one = drive(model);
+    sc.perception.threads = 2;
+    const Trace two = drive(compile_model(sc, s.track));
+    EXPECT_TRUE(same_rows(one.log, two.log)) << latency;
+    EXPECT_EQ(one.scans, two.scans);
+  }
+}
+
 TEST(Simulation, ADivergingCarEndsTheRunWithItsReasonNotACrash) {
   // a downforce coefficient of 1e300 on a tyre without load sensitivity
   // (far past the load-time bounds, set past them here: within the bounds
