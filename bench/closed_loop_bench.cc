@@ -32,16 +32,21 @@ using namespace paddock;
 // state.range(0): 0 the default scenario as shipped, 1 perception = ground_truth,
 // 2 perception = ground_truth and planner = oracle, 3 slam = lio, 4 slam = ground_truth,
 // 5 as shipped on two threads, 6 perception and slam = ground_truth, 7 the
-// same and planner = oracle
+// same and planner = oracle, 8 with a perception latency of one rotation on
+// two threads (the scans processed beside the loop)
 void BM_DefaultScenario(benchmark::State& state) {
   std::vector<std::string> overrides;
   const auto mode = state.range(0);
   const std::string path = std::string(PADDOCK_SOURCE_DIR) + "/scenarios/fsg_2023_trackdrive.ini";
-  if (mode == 5) overrides = runner::thread_overrides(2, runner::load_scenario(path));
-  if (mode == 1 || mode == 2 || mode >= 6) overrides.push_back("autonomy.perception=ground_truth");
+  if (mode == 8) overrides.push_back("perception.latency=0.1");
+  if (mode == 5 || mode == 8) {
+    const std::vector<std::string> t = runner::thread_overrides(2, runner::load_scenario(path, overrides));
+    overrides.insert(overrides.end(), t.begin(), t.end());
+  }
+  if (mode == 1 || mode == 2 || mode == 6 || mode == 7) overrides.push_back("autonomy.perception=ground_truth");
   if (mode == 2 || mode == 7) overrides.push_back("autonomy.planner=oracle");
   if (mode == 3) overrides.push_back("autonomy.slam=lio");
-  if (mode == 4 || mode >= 6) overrides.push_back("autonomy.slam=ground_truth");
+  if (mode == 4 || mode == 6 || mode == 7) overrides.push_back("autonomy.slam=ground_truth");
   const runner::Scenario sc = runner::load_scenario(path, overrides);
   const world::TrackModel track = world::build_track(runner::load_track_file(sc.track_path));
   runner::shared_car_envelope(sc.vehicle);  // the run reads it from here
@@ -57,7 +62,7 @@ void BM_DefaultScenario(benchmark::State& state) {
   state.counters["realtime_factor"] = benchmark::Counter(sim_seconds, benchmark::Counter::kIsRate);
   state.counters["finished"] = finished ? 1.0 : 0.0;
 }
-BENCHMARK(BM_DefaultScenario)->ArgName("mode")->DenseRange(0, 7)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+BENCHMARK(BM_DefaultScenario)->ArgName("mode")->DenseRange(0, 8)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
 
 // measuring the default car's g-g-v envelope (~1,000 s of closed-loop
 // experiments on the vehicle model): what a run pays beside its loop when
