@@ -47,17 +47,10 @@ std::vector<Cone> curve_cones() {
 }
 
 perception::PerceptionParams stage_params(double latency, int threads) {
+  // the sensors' own calibration, as the runner's stack_params gives it
   perception::PerceptionParams p;
   p.use_camera = true;
-  perception::LidarCalibration& lc = p.lidar.calibration;
-  lc.mount_x = kLidar.mount_x;
-  lc.mount_y = kLidar.mount_y;
-  lc.mount_z = kLidar.mount_z;
-  lc.mount_pitch = kLidar.mount_pitch;
-  lc.channels = kLidar.channels;
-  lc.elevation_min = kLidar.elevation_min;
-  lc.elevation_max = kLidar.elevation_max;
-  lc.columns = kLidar.columns;
+  p.lidar.calibration = static_cast<const hal::LidarLayout&>(kLidar);
   p.camera = sensors::camera_calibration(kCamera);
   p.latency = latency;
   p.threads = threads;
