@@ -63,7 +63,9 @@ struct PerceptionParams {
     v.section(PADDOCK_PARAM(fusion), "the LiDAR-camera fusion");
     v(PADDOCK_PARAM(camera_sync_tolerance), {"s", params::in(0.0, 1.0),
                                              "a camera frame serves the rotation it was exposed in, give or take this"});
-    v(PADDOCK_PARAM(latency), {"s", params::in(0.0, 1.0),
+    // (at most half the second of odometry and state estimates the stack
+    // keeps to place a frame at the pose of its stamp)
+    v(PADDOCK_PARAM(latency), {"s", params::in(0.0, 0.5),
                                "a scan's cones reach the localisation this long after the scan (the pipeline's compute on the car)"});
     v(PADDOCK_PARAM(threads), {"", params::in(1, 2),
                                "2: the scans are processed on a thread of their own beside the loop (the result is the same)"});

@@ -6,7 +6,8 @@ namespace paddock::stack {
 
 namespace {
 // inputs held for the next scan before they are applied without one (a
-// LiDAR gone silent): 5 s of the IMU, or a few camera frames (1 MB each)
+// LiDAR gone silent): some 3 s of the IMU and wheel speeds, or a few
+// camera frames (1 MB each)
 constexpr std::size_t kMaxQueued = 1024;
 constexpr std::size_t kMaxQueuedFrames = 4;
 }  // namespace

@@ -149,8 +149,9 @@ TEST(Simulation, APerceptionLatencyDelaysEachFrameAndTheScansThreadChangesNothin
   // each scan's cones reach the stack [perception] latency after the scan
   // came (at its rotation's end, a column after the last column's stamp):
   // none sooner, none later than the control cycle at that instant
+  // (0.5 s: the most it may be, the frames still placed at their stamps' poses)
   const ScenarioOnTrack& s = default_setup();
-  for (const double latency : {0.0, 0.1, 0.25}) {
+  for (const double latency : {0.0, 0.1, 0.25, 0.5}) {
     Scenario sc = s.scenario;
     sc.perception.latency = latency;
     const SimModel model = compile_model(sc, s.track);
@@ -166,6 +167,10 @@ TEST(Simulation, APerceptionLatencyDelaysEachFrameAndTheScansThreadChangesNothin
       EXPECT_LT(late, from_seconds(latency) + model.dt_ns * model.every.control) << latency << " s: frame " << frames;
     }
     EXPECT_GT(frames, 40) << latency;
+    // and SLAM took every one at its stamp's odometry (none too old for it)
+    ASSERT_NE(state.stack.localisation(), nullptr);
+    EXPECT_EQ(state.stack.localisation()->stats().dropped_frames, 0) << latency;
+    EXPECT_GT(state.stack.localisation()->stats().frames, 40) << latency;
     // a scan on a thread of its own: the same run, bit for bit
     if (latency == 0.0) continue;
     const Trace one = drive(model);
