@@ -102,11 +102,16 @@ void SnapshotRecorder::observe(const SimModel& model, SimState& s) {
       if (f.stamp == p->last().camera_stamp) frame = &f;
     snapshot_ = take_snapshot(*p, frame, s.true_poses.at(s.stack.last_detections().stamp), s.cones);
     p->set_keep_points(false);
+    if (s.raw) s.raw->set_pixels(pixels_before_);
     frames_.clear();
   } else if (!armed_ && static_cast<double>(s.k + 1) * model.dt >= snapshot_time - p->params().latency) {
-    // perception keeps the points from the next step's scan on (delivered
-    // from the snapshot's time on)
+    // perception keeps the points, and the camera paints its frames, from
+    // the next step's scan on (delivered from the snapshot's time on)
     p->set_keep_points(true);
+    if (s.raw) {
+      pixels_before_ = s.raw->pixels();
+      s.raw->set_pixels(true);
+    }
     armed_ = true;
   }
 }

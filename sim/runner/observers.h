@@ -167,6 +167,7 @@ class SnapshotRecorder final : public Observer {
 
  private:
   bool armed_ = false;
+  bool pixels_before_ = false;  // whether the camera painted its frames before arming
   long frames_seen_ = 0;
   // once armed, the camera's frames of the scans still in perception's
   // hands ([perception] latency), newest last

@@ -99,7 +99,8 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
   const auto shoot = [&] {
     // (a frame the log still encodes is left to it)
     hal::CameraFrame& frame = hal::writable(frame_).frame;
-    camera_->render(*world_, poses.at(exposure), exposure, frame, annotation_);
+    camera_->render(*world_, poses.at(exposure), exposure, frame, annotation_, pixels_);
+    frame_painted_ = pixels_;
     detection = detector_->detect(frame, annotation_);
   };
   std::vector<sensors::LidarPoint> raw;

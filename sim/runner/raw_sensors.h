@@ -75,9 +75,16 @@ class RawSensors {
                                         SimHal& hal, FaultInjector& faults, double t);
   // the stamp of the scan's last column (the scan's `end`) for a rotation ending at `now`
   TimeNs scan_end(TimeNs now) const;
-  // the last camera frame rendered (for the perception figures), or null
+  // whether the camera's frames are painted: only a reader of their pixels
+  // (a run's log, the perception snapshot) needs them, and asks; else each
+  // frame is only annotated, all the detector node reads (the same
+  // detections: Camera::render's pixels = false), off by default
+  void set_pixels(bool on) { pixels_ = on; }
+  bool pixels() const { return pixels_; }
+  // the last camera frame rendered with its pixels (for the perception
+  // figures and the log), or null (none yet, or the last one without them)
   const hal::CameraFrame* camera_frame() const {
-    return camera_ && frame_->frame.width > 0 ? &frame_->frame : nullptr;
+    return camera_ && frame_->frame.width > 0 && frame_painted_ ? &frame_->frame : nullptr;
   }
   // the same frame lent to a reader on another thread (the log's), without
   // a copy: the next render goes into a new frame while the lease is out
@@ -101,6 +108,8 @@ class RawSensors {
   std::unique_ptr<sensors::Camera> camera_;
   std::unique_ptr<sensors::AnnotationDetector> detector_;
   std::shared_ptr<hal::SharedFrame> frame_ = std::make_shared<hal::SharedFrame>();
+  bool pixels_ = false;         // set_pixels
+  bool frame_painted_ = false;  // the last frame was rendered with its pixels
   std::optional<hal::CameraDetections> frozen_;  // a frozen camera's last detections
   sensors::CameraAnnotation annotation_;
   sensors::GroundParams ground_;

@@ -53,7 +53,8 @@ void RunLog::observe(const SimModel& model, SimState& s) {
   // it) and what it made of the world; with transport = udp the car binary
   // logs them
   if (s.controlled && !s.hal.remote() && s.hal.sent()) log_->cycle(at, *s.hal.sent(), s.stack);
-  // the camera's frames, as the car logs them
+  // the camera's frames, as the car logs them (painted from now on)
+  if (s.raw) s.raw->set_pixels(true);
   if (const hal::CameraFrame* f = s.raw ? s.raw->camera_frame() : nullptr; f && f->stamp != last_image_) {
     last_image_ = f->stamp;
     log_->image(at, s.raw->lend_camera_frame(), kJpegQuality);

@@ -348,13 +348,13 @@ AnnotatedFrame Camera::render(const LidarWorld& world, const Pose2& base_pose, T
 }
 
 void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp, hal::CameraFrame& out,
-                    CameraAnnotation& annotation) {
+                    CameraAnnotation& annotation, bool pixels) {
   const int W = params_.width, H = params_.height;
   const std::size_t n_px = static_cast<std::size_t>(W) * static_cast<std::size_t>(H);
   out.stamp = stamp;
   out.width = W;
   out.height = H;
-  const bool same_image = out.rgb.size() == 3 * n_px && out.rgb.data() == rgb_buffer_;
+  const bool same_image = pixels && out.rgb.size() == 3 * n_px && out.rgb.data() == rgb_buffer_;
   out.rgb.resize(3 * n_px);
   // the labels: -1 everywhere; when the buffer is the one this camera wrote
   // last frame (as the runner passes it), only the pixels it labelled then
@@ -370,15 +370,16 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   // frame and that frame was the flat ground's background (the same every
   // frame: it depends on the mount's pitch alone) with painted_ drawn on it,
   // only those pixels differ from the background
+  // (without pixels nothing is painted: the next image is painted whole)
   const bool background_kept = same_image && flat_background_;
-  rgb_buffer_ = out.rgb.data();
+  rgb_buffer_ = pixels ? out.rgb.data() : nullptr;
   flat_background_ = false;
   annotation.instances.clear();
   last_primary_rays_ = last_continued_rays_ = 0;
   annotation.listed = true;  // (the list is labelled_, copied at the end)
   annotation.labelled.clear();
   if (!finite(base_pose.x) || !finite(base_pose.y) || !finite(base_pose.yaw)) {
-    std::fill(out.rgb.begin(), out.rgb.end(), std::uint8_t{0});
+    if (pixels) std::fill(out.rgb.begin(), out.rgb.end(), std::uint8_t{0});
     return;
   }
   // a new stamp for "inside a box this frame"; on wrap-around, clear the stamps
@@ -404,7 +405,9 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   // background, row by row: with no roll the x axis is level, so a row's rays
   // all point up (sky) or all down (flat ground)
   const auto ground_row = [&](std::size_t j) { return flat_ground && by_[j] * col[1][2] + col[2][2] < 0.0; };
-  if (background_kept && flat_ground) {
+  if (!pixels) {
+    // no image
+  } else if (background_kept && flat_ground) {
     for (std::uint32_t p : painted_) {
       const std::array<std::uint8_t, 3>& rgb = ground_row(p / static_cast<std::uint32_t>(W)) ? ground_rgb_ : sky_rgb_;
       std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
@@ -568,7 +571,7 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   // tile (through its middle pixel) colours the tile's pixels that no box
   // holds; a tile whose ray meets a cone takes the ground's colour under the
   // hit from the height field's own normal
-  if (!flat_ground) {
+  if (!flat_ground && pixels) {
     tiles_.clear();
     for (int tj = 0; tj < H; tj += kGroundTile) {
       const int j = std::min(H - 1, tj + kGroundTile / 2);
@@ -618,18 +621,21 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
     if (cone == kHitGround && flat_ground) return;  // the analytic ground is the same
     const double t = rh.ray.tfar[k];
     if (cone == kHitStructure) {  // a barrier block: opaque, nothing behind it counts
+      if (!pixels) return;
       const std::array<std::uint8_t, 3> rgb = shade(albedo(params_, LidarMaterial::Barrier), lambert_of(rh, k));
       std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
       painted_.push_back(p);
       return;
     }
-    const LidarMaterial m =
-        cone < 0 ? LidarMaterial::Ground
-                 : world.material_of(rh.hit.geomID[k], rh.hit.primID[k], o[0] + t * rh.ray.dir_x[k],
-                                     o[1] + t * rh.ray.dir_y[k], o[2] + t * rh.ray.dir_z[k]);
-    const std::array<std::uint8_t, 3> rgb = shade(albedo(params_, m), lambert_of(rh, k));
-    std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
-    painted_.push_back(p);
+    if (pixels) {
+      const LidarMaterial m =
+          cone < 0 ? LidarMaterial::Ground
+                   : world.material_of(rh.hit.geomID[k], rh.hit.primID[k], o[0] + t * rh.ray.dir_x[k],
+                                       o[1] + t * rh.ray.dir_y[k], o[2] + t * rh.ray.dir_z[k]);
+      const std::array<std::uint8_t, 3> rgb = shade(albedo(params_, m), lambert_of(rh, k));
+      std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
+      painted_.push_back(p);
+    }
     if (cone >= 0) {
       annotation.labels[p] = cone;
       labelled_.push_back(p);
@@ -700,13 +706,15 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   // from rng_ once a frame: five draws per 64-bit word)
   if (!noise_.empty()) {
     GaussianStream draws(rng_());
-    for (std::uint8_t& byte : out.rgb) {
-      const int v = byte + noise_[draws.index()];
-      byte = static_cast<std::uint8_t>(std::clamp(v, 0, 255));
+    if (pixels) {
+      for (std::uint8_t& byte : out.rgb) {
+        const int v = byte + noise_[draws.index()];
+        byte = static_cast<std::uint8_t>(std::clamp(v, 0, 255));
+      }
     }
   }
   // (flat ground: the tiles paint no pixel; noise touches every one)
-  flat_background_ = flat_ground && noise_.empty();
+  flat_background_ = pixels && flat_ground && noise_.empty();
   annotation.labelled.assign(labelled_.begin(), labelled_.end());
 }
 

@@ -286,9 +286,14 @@ class Camera {
   // camera's last call, unchanged since, only the pixels it labelled then
   // are reset; when out.rgb is, and that frame was flat ground's without
   // noise, only the pixels its rays drew are (anything else must not write
-  // into either)
+  // into either).
+  // pixels = false: the annotation alone, for a detector node that reads
+  // nothing else (AnnotationDetector): the same labels and instances, out's
+  // stamp and size, and out.rgb sized but left as it was (no background, no
+  // shading, no ground tiles on non-flat ground, no noise added; the random
+  // stream moves on as it would); the next call with pixels paints them all
   void render(const LidarWorld& world, const Pose2& base_pose, TimeNs stamp, hal::CameraFrame& out,
-              CameraAnnotation& annotation);
+              CameraAnnotation& annotation, bool pixels = true);
 
   const CameraParams& params() const { return params_; }
   // K and T_camera_base, exactly those render() uses

@@ -442,7 +442,10 @@ TEST(Camera, ReusedBuffersGiveTheFramesFreshOnesGive) {
   // bumpy one and a flat one with barrier blocks (their pixels drawn too),
   // in turn, with a non-finite pose among them; with and without pixel
   // noise: each frame as fresh buffers give it (a twin camera, the same
-  // calls, its own random stream alike)
+  // calls, its own random stream alike). A third camera renders every third
+  // frame without pixels (pixels = false) into buffers of its own: those
+  // frames' annotations are the fresh ones', and its next image with pixels
+  // is the fresh one (painted whole, its random stream kept in step)
   GroundParams bumpy;
   bumpy.bump_height = 0.3;
   bumpy.bump_wavelength = 8.0;
@@ -462,9 +465,10 @@ TEST(Camera, ReusedBuffersGiveTheFramesFreshOnesGive) {
     p.width = 320;
     p.height = 200;
     p.pixel_noise = noise;
-    Camera reused(p, 1), fresh(p, 1);
-    hal::CameraFrame frame;
-    CameraAnnotation annotation;
+    Camera reused(p, 1), fresh(p, 1), sparse(p, 1);
+    hal::CameraFrame frame, sparse_frame;
+    CameraAnnotation annotation, sparse_annotation;
+    int without_pixels = 0;
     const std::size_t m = track.centreline.size();
     int labelled_frames = 0, barrier_frames = 0;
     for (int s = 0; s < 24; ++s) {
@@ -474,13 +478,28 @@ TEST(Camera, ReusedBuffersGiveTheFramesFreshOnesGive) {
       Pose2 pose{a.x, a.y, angle_of(b - a)};
       if (s == 7) pose.yaw = std::nan("");
       reused.render(world, pose, s, frame, annotation);
+      const bool pixels = s % 3 != 1;
+      sparse.render(world, pose, s, sparse_frame, sparse_annotation, pixels);
       const AnnotatedFrame want = fresh.render(world, pose, s);
       EXPECT_TRUE(frame.rgb == want.frame.rgb) << "noise " << noise << ", frame " << s;
       EXPECT_TRUE(annotation.labels == want.annotation.labels) << "noise " << noise << ", frame " << s;
+      EXPECT_TRUE(sparse_annotation.labels == want.annotation.labels) << "noise " << noise << ", frame " << s;
+      EXPECT_EQ(sparse_frame.stamp, want.frame.stamp);
+      EXPECT_EQ(sparse_frame.rgb.size(), want.frame.rgb.size());
+      if (pixels) {
+        EXPECT_TRUE(sparse_frame.rgb == want.frame.rgb) << "noise " << noise << ", frame " << s;
+      } else {
+        ++without_pixels;
+      }
       ASSERT_EQ(annotation.instances.size(), want.annotation.instances.size()) << s;
+      ASSERT_EQ(sparse_annotation.instances.size(), want.annotation.instances.size()) << s;
       for (std::size_t k = 0; k < want.annotation.instances.size(); ++k) {
         EXPECT_EQ(annotation.instances[k].id, want.annotation.instances[k].id);
         EXPECT_EQ(annotation.instances[k].visible_fraction, want.annotation.instances[k].visible_fraction);
+        EXPECT_EQ(sparse_annotation.instances[k].id, want.annotation.instances[k].id);
+        EXPECT_EQ(sparse_annotation.instances[k].color, want.annotation.instances[k].color);
+        EXPECT_EQ(sparse_annotation.instances[k].range, want.annotation.instances[k].range);
+        EXPECT_EQ(sparse_annotation.instances[k].visible_fraction, want.annotation.instances[k].visible_fraction);
       }
       labelled_frames += std::any_of(want.annotation.labels.begin(), want.annotation.labels.end(),
                                      [](std::int32_t l) { return l >= 0; });
@@ -496,6 +515,7 @@ TEST(Camera, ReusedBuffersGiveTheFramesFreshOnesGive) {
       }
     }
     EXPECT_GE(labelled_frames, 20) << "noise " << noise;  // cones in (nearly) every frame
+    EXPECT_EQ(without_pixels, 8);
     if (noise == 0.0) {
       EXPECT_GE(barrier_frames, 2);  // and the blocks drawn where they were
     }
