@@ -13,6 +13,10 @@
 //   BM_CameraFrameBumpy  the same on a bumpy ground (height field: every
 //                    pixel of the boxes plus a ray per 4 x 4 tile)
 //   BM_CameraFrameNoisy  the same with 2 levels of pixel noise
+//   BM_CameraAnnotation, BM_CameraAnnotationBumpy  the frames of
+//                    BM_CameraFrame and BM_CameraFrameBumpy annotated
+//                    without their pixels (pixels = false: what a run that
+//                    neither logs nor snapshots its frames renders)
 //   BM_Detector      sensors::AnnotationDetector::detect on such a frame and
 //                    its annotation (a pass over the labels, the error model)
 //   BM_Fusion        fuse() of 60 candidates (the cones within 20 m ahead and
@@ -63,7 +67,7 @@ void report(benchmark::State& state, std::vector<double>& ms) {
 }
 
 void camera_frames(benchmark::State& state, const sensors::GroundParams& ground,
-                   const sensors::CameraParams& params = {}, bool culling = true) {
+                   const sensors::CameraParams& params = {}, bool culling = true, bool pixels = true) {
   const world::TrackModel track = fsg_2023();
   const sensors::LidarWorld world(track.cones, {}, ground);
   sensors::Camera camera(params, 1);
@@ -76,7 +80,7 @@ void camera_frames(benchmark::State& state, const sensors::GroundParams& ground,
   for (auto _ : state) {
     const Pose2& pose = poses[k++ % poses.size()];
     const auto t0 = std::chrono::steady_clock::now();
-    camera.render(world, pose, 0, frame, annotation);
+    camera.render(world, pose, 0, frame, annotation, pixels);
     const auto t1 = std::chrono::steady_clock::now();
     ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     rays += camera.last_primary_rays() + camera.last_continued_rays();
@@ -109,6 +113,17 @@ void BM_CameraFrameNoisy(benchmark::State& state) {
   camera_frames(state, {}, p);
 }
 BENCHMARK(BM_CameraFrameNoisy)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+void BM_CameraAnnotation(benchmark::State& state) { camera_frames(state, {}, {}, true, false); }
+BENCHMARK(BM_CameraAnnotation)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+void BM_CameraAnnotationBumpy(benchmark::State& state) {
+  sensors::GroundParams g;
+  g.bump_height = 0.1;
+  g.bump_wavelength = 10.0;
+  camera_frames(state, g, {}, true, false);
+}
+BENCHMARK(BM_CameraAnnotationBumpy)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 // a frame from the start pose of the track, for the detector and the fusion
 struct Scene {
