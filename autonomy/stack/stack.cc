@@ -134,7 +134,8 @@ void Stack::on_message(hal::SensorMessage&& m) {
 }
 
 void Stack::deliver_perception(TimeNs now) {
-  for (;;) {
+  // (every cycle asks: nothing timed when no scan is on its way)
+  while (perception_->in_flight() > 0) {
     const perception::PerceptionFrame* f =
         timed(profile_, Stage::Perception, [&] { return perception_->deliver(now); });
     if (f == nullptr) return;

@@ -405,14 +405,13 @@ void Camera::render(const LidarWorld& world, const Pose2& base_pose, TimeNs stam
   // background, row by row: with no roll the x axis is level, so a row's rays
   // all point up (sky) or all down (flat ground)
   const auto ground_row = [&](std::size_t j) { return flat_ground && by_[j] * col[1][2] + col[2][2] < 0.0; };
-  if (!pixels) {
-    // no image
-  } else if (background_kept && flat_ground) {
+  // (without pixels background_kept is false, and nothing is painted)
+  if (background_kept && flat_ground) {
     for (std::uint32_t p : painted_) {
       const std::array<std::uint8_t, 3>& rgb = ground_row(p / static_cast<std::uint32_t>(W)) ? ground_rgb_ : sky_rgb_;
       std::copy(rgb.begin(), rgb.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(p));
     }
-  } else {
+  } else if (pixels) {
     for (int j = 0; j < H; ++j) {
       const std::vector<std::uint8_t>& row = ground_row(static_cast<std::size_t>(j)) ? ground_row_ : sky_row_;
       std::copy(row.begin(), row.end(), out.rgb.begin() + 3 * static_cast<std::ptrdiff_t>(j) * W);

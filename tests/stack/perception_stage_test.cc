@@ -12,11 +12,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include "autonomy/common/same_bits.h"
 #include "sim/sensors/annotation_detector.h"
 #include "sim/sensors/camera.h"
 #include "sim/sensors/lidar.h"
@@ -102,23 +102,20 @@ std::vector<Event> drive(int rotations, TimeNs lead = from_seconds(0.2)) {
   return events;
 }
 
-bool same_float(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-bool same_double(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
-
 // the frames' every result, bit for bit
 void expect_same(const perception::PerceptionFrame& a, const perception::PerceptionFrame& b, const std::string& what) {
   SCOPED_TRACE(what);
   EXPECT_EQ(a.output.stamp, b.output.stamp);
   ASSERT_EQ(a.output.cones.size(), b.output.cones.size());
   for (std::size_t i = 0; i < a.output.cones.size(); ++i) {
-    EXPECT_TRUE(same_double(a.output.cones[i].position.x, b.output.cones[i].position.x)) << i;
-    EXPECT_TRUE(same_double(a.output.cones[i].position.y, b.output.cones[i].position.y)) << i;
+    EXPECT_TRUE(same_bits(a.output.cones[i].position.x, b.output.cones[i].position.x)) << i;
+    EXPECT_TRUE(same_bits(a.output.cones[i].position.y, b.output.cones[i].position.y)) << i;
     EXPECT_EQ(a.output.cones[i].color, b.output.cones[i].color) << i;
     EXPECT_EQ(a.output.cones[i].colour_from_camera, b.output.cones[i].colour_from_camera) << i;
   }
   ASSERT_EQ(a.output.free_range.size(), b.output.free_range.size());
   for (std::size_t i = 0; i < a.output.free_range.size(); ++i)
-    EXPECT_TRUE(same_float(a.output.free_range[i], b.output.free_range[i])) << i;
+    EXPECT_TRUE(same_bits(a.output.free_range[i], b.output.free_range[i])) << i;
   EXPECT_EQ(a.lidar.ok, b.lidar.ok);
   EXPECT_EQ(a.lidar.corrected, b.lidar.corrected);
   EXPECT_EQ(a.lidar.cones.size(), b.lidar.cones.size());
