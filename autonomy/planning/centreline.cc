@@ -29,6 +29,10 @@ struct EdgeInfo {
   // with the edge's cone list, the first time the search needs either
   // (Search::near_cones)
   double colour_a_left = 0.0;
+  // the part of that average that is against the edge whichever way it is
+  // crossed: its two cones of one colour (a boundary, or the strip between
+  // two lanes), <= 0
+  double colour_against = 0.0;
 };
 
 // the factors of a step onto an edge's midpoint that do not depend on the
@@ -350,11 +354,15 @@ class Search {
     EdgeInfo& in = info_[e];
     const Vec2 m = in.mid;
     const std::size_t ia = edge_a_[e], ib = edge_b_[e];
-    double sum = 0.0, weight = 0.0;
+    double sum = 0.0, against = 0.0, weight = 0.0;
     const bool same = coloured(cones[ia].color) && cones[ia].color == cones[ib].color;
     for (std::size_t i : {ia, ib}) {
       if (!coloured(cones[i].color)) continue;
-      sum += 2.0 * (same ? -1.0 : vote(cones[i].color, i == ia));
+      if (same) {
+        against -= 2.0;
+      } else {
+        sum += 2.0 * vote(cones[i].color, i == ia);
+      }
       weight += 2.0;
     }
     cone_first_[e] = cone_list_.size();
@@ -377,6 +385,7 @@ class Search {
       }
     }
     in.colour_a_left = weight > 0.0 ? sum / weight : 0.0;
+    in.colour_against = weight > 0.0 ? against / weight : 0.0;
     cone_count_[e] = cone_list_.size() - cone_first_[e];
   }
 
@@ -437,7 +446,7 @@ class Search {
     StepTerms t;
     t.u = d / l;
     // colour: blue on the left and yellow on the right of the step
-    t.colour = cross(t.u, e.a - e.mid) > 0.0 ? e.colour_a_left : -e.colour_a_left;
+    t.colour = (cross(t.u, e.a - e.mid) > 0.0 ? e.colour_a_left : -e.colour_a_left) + e.colour_against;
     // the track width: the edge's extent across the direction of travel (a
     // diagonal rung between staggered cones is longer than the track is wide)
     const double across_edge = std::abs(cross(t.u, e.dir));

@@ -27,13 +27,18 @@ namespace paddock::planning {
 // constraints that every ground-truth lap, with and without colours, closes
 // with >= 0.9 m between trajectory and boundary lines, and that the cones
 // within 20 m of each start give an open path inside the track. Checked on
-// 30 other seeds (840 laps): 41 of 420 fail with colours, 48 without; 20
-// and 22 of them on fss_2022_v1, whose infield strip between two blue lines
-// looks like a lane once a boundary cone is missing. Missed cones cause
-// nearly all failures (colour swaps alone: 1 in 420, noise alone: 0), and
-// with colours most are safe: the search stops, inside the track, at a gap
-// of two or three missed cones in a row that it cannot bridge. The counts
-// quoted below are of those 840 laps (89 with the defaults).
+// 30 other seeds (840 laps, seeds 101-130: path_planner_test.cc,
+// PathPlannerTracks.PerturbedMapsOnEveryCircuit): 29 of 420 fail with
+// colours, 48 without; 13 and 23 of them on fss_2022_v1, whose infield
+// strip between two blue lines looks like a lane once a boundary cone is
+// missing. Missed cones cause nearly all failures (colour swaps alone: 1 in
+// 420, noise alone: 0), and with colours most are safe: the search stops,
+// inside the track, at a gap of two or three missed cones in a row that it
+// cannot bridge. The counts quoted below for each field are of those 840
+// laps as they were before 2026-11-29 (89 with the defaults, 40 with
+// colours), when an edge between two cones of one colour scored as a
+// perfect rung for a step with its first cone on the right (near_cones);
+// weight_colour again since: 0.5: 30, 1: 29, 2: 36, 3: 48 with colours.
 // Every field is an INI key `[planning.search] <name>`.
 struct CentrelineParams {
   // the event horizon's largest depth and beam width (the search keeps a

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -219,6 +220,48 @@ TEST(Centreline, Deterministic) {
     EXPECT_EQ(a.points[i], b.points[i]);
     EXPECT_EQ(a.steps[i].edge, b.steps[i].edge);
   }
+}
+
+// a rung between two cones of one colour (a swapped cone, or a boundary
+// edge as long as a rung) scores against the step whichever way it is
+// crossed. The search once kept the two cones' vote as evidence for the
+// edge's first cone's side, so a step that crossed it with that cone on its
+// right scored the colour as a perfect rung's: which way that was depended
+// on the cones' order in the map (an edge's first cone is the lower index),
+// and on FSG 2019 the search stepped through a yellow boundary into the
+// infield.
+TEST(Centreline, ARungOfOneColourScoresAgainstWhicheverWayItsEdgeIsStored) {
+  std::vector<Cone> cones = straight_track(60.0);
+  // the blue cones at x = 20 and 24 taken for yellow ones: the four rungs
+  // from them to the yellow cones at x = 18, 22 and 26 have one colour, too
+  // many for a step to pass over (search_radius)
+  for (Cone& c : cones)
+    if (c.color == ConeColor::Blue && (std::abs(c.position.x - 20.0) < 1e-9 || std::abs(c.position.x - 24.0) < 1e-9))
+      c.color = ConeColor::Yellow;
+  const std::vector<Cone> reversed(cones.rbegin(), cones.rend());
+  const CentrelineResult a = search(cones, {-1.0, 0.0, 0.0});
+  const CentrelineResult b = search(reversed, {-1.0, 0.0, 0.0});
+  ASSERT_TRUE(a.ok()) << a.reason;
+  ASSERT_TRUE(b.ok()) << b.reason;
+  // the same path and the same scores, whatever the cones' order
+  ASSERT_EQ(a.points.size(), b.points.size());
+  double lowest_other = 1.0;
+  int one_colour = 0;
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    EXPECT_NEAR(distance(a.points[i], b.points[i]), 0.0, 1e-12) << i;
+    EXPECT_NEAR(a.steps[i].terms.colour, b.steps[i].terms.colour, 1e-12) << i;
+    // the one-colour rungs' midpoints: (19, 0) to (25, 0)
+    const Vec2 q = a.points[i];
+    if (std::abs(q.y) < 1e-9 && q.x > 18.5 && q.x < 25.5) {
+      ++one_colour;
+      EXPECT_LT(a.steps[i].terms.colour, 0.0) << i;
+    } else if (q.x < 15.0 || q.x > 25.0) {
+      lowest_other = std::min(lowest_other, a.steps[i].terms.colour);
+    }
+  }
+  // the path still runs down the middle, over a swapped rung
+  EXPECT_GE(one_colour, 1);
+  EXPECT_GT(lowest_other, 0.5);
 }
 
 // ---- abnormal inputs: a status and a reason, never a crash ------------------------------

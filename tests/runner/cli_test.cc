@@ -138,14 +138,15 @@ std::uint64_t fnv1a64(const std::string& bytes) {
 }
 
 // the pinned fingerprint for this CPU's maker: tests/data/determinism.txt,
-// line "log_fnv1a64_intel = 0x..." on Intel, else "log_fnv1a64 = 0x..."
-// (why a maker has its own: the file's header)
+// line "log_fnv1a64_intel = 0x..." on Intel, else "log_fnv1a64 = 0x...";
+// "unmeasured" when it has not been measured on that maker since the last
+// change of a result (why a maker has its own: the file's header)
 std::string pinned_log_hash() {
   const std::string text = paddock::runner::read_file(kRoot + "/tests/data/determinism.txt");
   __builtin_cpu_init();
   const std::string key = __builtin_cpu_is("intel") ? "log_fnv1a64_intel" : "log_fnv1a64";
   std::smatch m;
-  if (!std::regex_search(text, m, std::regex("(^|\n)" + key + " = (0x[0-9a-f]{16})"))) return "";
+  if (!std::regex_search(text, m, std::regex("(^|\n)" + key + " = (0x[0-9a-f]{16}|unmeasured)(\n|$)"))) return "";
   return m[2];
 }
 
@@ -168,8 +169,11 @@ TEST(Cli, SameScenarioAndSeedGiveIdenticalSummaryAndLog) {
   std::snprintf(hash, sizeof hash, "0x%016llx", static_cast<unsigned long long>(fnv1a64(log_a)));
   // (pinned for machines with AVX2 and FMA, Embree's kernels and glibc's
   // libm the same there; other machines round differently)
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
-    EXPECT_EQ(std::string(hash), pinned_log_hash())
+  const std::string pinned = pinned_log_hash();
+  if (pinned == "unmeasured") {
+    std::printf("the log's hash %s: not pinned for this CPU's maker yet (tests/data/determinism.txt)\n", hash);
+  } else if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
+    EXPECT_EQ(std::string(hash), pinned)
         << "the default run's log changed; if on purpose, set "
         << (__builtin_cpu_is("intel") ? "log_fnv1a64_intel" : "log_fnv1a64") << " = " << hash
         << " in tests/data/determinism.txt (the other maker's too, measured there) and say why in the commit";
