@@ -4,8 +4,7 @@
 
 namespace paddock::stack {
 
-std::vector<Segment> find_gates(const std::vector<Cone>& cones, const GateParams& p) {
-  // posts: the mean of the big orange cones within post_radius of a post's first cone
+std::vector<Vec2> find_posts(const std::vector<Cone>& cones, const GateParams& p) {
   std::vector<Vec2> posts;
   std::vector<int> members;
   for (const Cone& c : cones) {
@@ -20,6 +19,11 @@ std::vector<Segment> find_gates(const std::vector<Cone>& cones, const GateParams
       posts[k] += (c.position - posts[k]) / static_cast<double>(members[k]);
     }
   }
+  return posts;
+}
+
+std::vector<Segment> find_gates(const std::vector<Cone>& cones, const GateParams& p) {
+  const std::vector<Vec2> posts = find_posts(cones, p);
   // each post's nearest partner in the width band; mutual pairs are gates
   const std::size_t n = posts.size();
   std::vector<std::size_t> nearest(n, n);

@@ -28,6 +28,11 @@ struct GateParams {
   std::string check() const { return max_width >= min_width ? "" : "max_width must be >= min_width"; }
 };
 
+// the posts the big orange cones of `cones` form: each the mean of the big
+// orange cones within post_radius of its first one, in the order of those
+// first cones
+std::vector<Vec2> find_posts(const std::vector<Cone>& cones, const GateParams& params = {});
+
 // the gates the big orange cones of `cones` form, each as a segment between
 // its two posts (unoriented: orient with orient_gate); a post pairs with its
 // nearest other post when that one's nearest is it too and their distance is

@@ -92,7 +92,9 @@ struct MissionParams {
   // swings the car across it
   double lap_switch_heading = 0.1;
   // a timekeeping gate is learned from big orange cones seen at least
-  // gate_min_observations times whose gate's middle lies within
+  // gate_min_observations times as big orange cones (their votes: a cone
+  // seen as small often and as big once, by a ghost that fell on it, is no
+  // post) whose gate's middle lies within
   // gate_max_offset of the planned path: a ghost cone of perception must not
   // become a finish line
   int gate_min_observations = 5;
@@ -277,6 +279,9 @@ class Stack {
   // distance (m)
   std::optional<std::pair<Vec2, double>> crossed_since_last(const Segment& g, Vec2 base) const;
   bool gate_still_seen(const Segment& g) const;
+  // the map's big orange cones seen as big at least gate_min_observations
+  // times (votes), what the gates are found in
+  std::vector<Cone> gate_cones() const;
   void start_stopping(TimeNs now, double speed);
   hal::ActuatorCommand safe_stop(TimeNs now, const std::string& reason);
   // what the machine sees this cycle
