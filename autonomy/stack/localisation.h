@@ -154,6 +154,9 @@ class Localisation {
   // mode = odometry: the stack builds its map at the poses (pose_at);
   // mode = fastslam: the map is SLAM's
   bool owns_map() const { return mode_ != SlamMode::Odometry; }
+  // with a pose graph (fastslam_graph, lio_graph): no loop closure has
+  // optimised it yet, so the map still holds the first lap's drift
+  bool awaits_loop_closure() const { return graph() && stats_.loop_closures == 0; }
   // true once after SLAM's map changed
   bool take_map_news();
   // SLAM's map: the confirmed landmarks of the highest-weight particle

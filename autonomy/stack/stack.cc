@@ -271,7 +271,15 @@ void Stack::plan(const hal::StateEstimate& st) {
     // the planner gives the open path along it (plan_path's `lap`)
     const bool back_at_start =
         start_position_ && distance(st.pose.position(), *start_position_) < mp.loop_closure_radius;
-    if (back_at_start || mp.loop_closure_radius <= 0.0) {
+    // with a pose graph, the lap a trackdrive keeps is planned on the map
+    // its first loop closure optimised: planned on the first lap's map, the
+    // lap would keep that lap's drift, which the closure then takes out of
+    // the map the car localises in (FSG 2023 with a noisy perception, seed
+    // 2: the lap planned 0.3 s before the closure, its far end 0.5 m off
+    // the cones there, three of them knocked in lap 3)
+    const bool map_closed = spec_.mission != Mission::Trackdrive || !localisation_ ||
+                            !localisation_->owns_map() || !localisation_->awaits_loop_closure();
+    if ((back_at_start || mp.loop_closure_radius <= 0.0) && map_closed) {
       // the lap to drive from now on: its racing line when asked for (the
       // centreline when that fails, and the fault says why)
       if (spec_.mission == Mission::Trackdrive && !planning::plan_locked_lap(res, cones, params_.planning)) {
