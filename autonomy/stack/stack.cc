@@ -277,8 +277,15 @@ void Stack::plan(const hal::StateEstimate& st) {
     // the map the car localises in (FSG 2023 with a noisy perception, seed
     // 2: the lap planned 0.3 s before the closure, its far end 0.5 m off
     // the cones there, three of them knocked in lap 3)
-    const bool map_closed = spec_.mission != Mission::Trackdrive || !localisation_ ||
-                            !localisation_->owns_map() || !localisation_->awaits_loop_closure();
+    // A closure the localisation misses (too few of the start's cones
+    // matched on this pass) is not waited for past loop_closure_radius of
+    // driving: the lap is then planned on the map as it is, as before
+    bool map_closed = spec_.mission != Mission::Trackdrive || !localisation_ || !localisation_->owns_map() ||
+                      !localisation_->awaits_loop_closure();
+    if (!map_closed && back_at_start) {
+      if (!lap_ready_at_) lap_ready_at_ = driven_;
+      map_closed = driven_ - *lap_ready_at_ >= mp.loop_closure_radius;
+    }
     if ((back_at_start || mp.loop_closure_radius <= 0.0) && map_closed) {
       // the lap to drive from now on: its racing line when asked for (the
       // centreline when that fails, and the fault says why)

@@ -316,6 +316,9 @@ class Stack {
   std::optional<Vec2> last_base_position_;  // for the gate crossing test
   double driven_ = 0.0;                     // distance driven (m)
   std::optional<Vec2> start_position_;      // where the car began to drive
+  // driven_ when a trackdrive's lap could first have been locked but the
+  // pose graph had not closed the loop yet (Stack::plan)
+  std::optional<double> lap_ready_at_;
   double last_crossing_at_ = -1e9;          // driven_ at the last counted crossing (m)
   // the base positions driven since the last counted crossing, with driven_
   // at each (one every kPathMarkSpacing m): a gate first seen after the car
