@@ -240,6 +240,31 @@ std::vector<Cone> corridor(double x_last) {
   return track;
 }
 
+// the corridor with a timekeeping gate's big orange cones at x = 10
+std::vector<Cone> corridor_with_gate(double x_last) {
+  std::vector<Cone> track = corridor(x_last);
+  track.push_back({{10.0, 2.6}, ConeColor::BigOrange});
+  track.push_back({{10.0, -2.6}, ConeColor::BigOrange});
+  return track;
+}
+
+// the stack the corridor's gate tests drive: the Delaunay planner, no wait
+// after AS Ready
+StackParams corridor_params() {
+  StackParams p;
+  p.autonomy.planner = PlannerMode::Delaunay;
+  p.as.ready_wait = 0.0;
+  return p;
+}
+
+// an autocross that finishes at its `crossings`-th gate crossing
+MissionSpec autocross(int crossings) {
+  MissionSpec m;
+  m.mission = Mission::Autocross;
+  m.finish_crossings = crossings;
+  return m;
+}
+
 // drives the stack's car along +x, ignoring its commands: at rest at x0 for
 // 1 s (the go at 0.5 s), then 5 m/s, 100 ticks a second, until past x_stop or
 // after `seconds`. Every 0.1 s a perception frame holds each cone i for which
@@ -277,16 +302,10 @@ void drive_corridor(Stack& s, Mission mission, const std::vector<Cone>& track, d
 // second pair as small cones, so that gate is forgotten and not counted
 // (counted, it would be the autocross's finish and stop the car)
 TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
-  StackParams p;
-  p.autonomy.planner = PlannerMode::Delaunay;
-  p.as.ready_wait = 0.0;
-  MissionSpec m;
-  m.mission = Mission::Autocross;
-  m.finish_crossings = 2;
+  const StackParams p = corridor_params();
+  const MissionSpec m = autocross(2);
   Stack s(p, m);
-  std::vector<Cone> track = corridor(70.0);
-  track.push_back({{10.0, 2.6}, ConeColor::BigOrange});
-  track.push_back({{10.0, -2.6}, ConeColor::BigOrange});
+  std::vector<Cone> track = corridor_with_gate(70.0);
   const std::size_t fake_left = track.size();
   track.push_back({{30.0, 2.6}, ConeColor::BigOrange});
   track.push_back({{30.0, -2.6}, ConeColor::BigOrange});
@@ -315,16 +334,10 @@ TEST(Stack, ALearnedGateTheMapNoLongerShowsIsNotCounted) {
 // its crossing finishes the run (the finish line was once forgotten so, on
 // FSG 2019 without colours, and the car drove on)
 TEST(Stack, ABigConeMisjudgedNearAGatesPostKeepsTheGate) {
-  StackParams p;
-  p.autonomy.planner = PlannerMode::Delaunay;
-  p.as.ready_wait = 0.0;
-  MissionSpec m;
-  m.mission = Mission::Autocross;
-  m.finish_crossings = 1;
+  const StackParams p = corridor_params();
+  const MissionSpec m = autocross(1);
   Stack s(p, m);
-  std::vector<Cone> track = corridor(70.0);
-  track.push_back({{10.0, 2.6}, ConeColor::BigOrange});
-  track.push_back({{10.0, -2.6}, ConeColor::BigOrange});
+  std::vector<Cone> track = corridor_with_gate(70.0);
   const std::size_t misjudged = track.size();
   track.push_back({{6.0, -2.3}, ConeColor::BigOrange});
   int crossings_before = -1;
@@ -355,16 +368,10 @@ TEST(Stack, ABigConeMisjudgedNearAGatesPostKeepsTheGate) {
 // calls them big, but they were seen big once, not gate_min_observations
 // times: no gate there, and the autocross's second crossing not counted
 TEST(Stack, ConesSeenBigOnceMakeNoGate) {
-  StackParams p;
-  p.autonomy.planner = PlannerMode::Delaunay;
-  p.as.ready_wait = 0.0;
-  MissionSpec m;
-  m.mission = Mission::Autocross;
-  m.finish_crossings = 2;
+  const StackParams p = corridor_params();
+  const MissionSpec m = autocross(2);
   Stack s(p, m);
-  std::vector<Cone> track = corridor(70.0);
-  track.push_back({{10.0, 2.6}, ConeColor::BigOrange});
-  track.push_back({{10.0, -2.6}, ConeColor::BigOrange});
+  std::vector<Cone> track = corridor_with_gate(70.0);
   bool ghost_big_in_map = false;
   drive_corridor(
       s, m.mission, track, 0.0, 30.0, 10,
