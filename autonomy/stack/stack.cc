@@ -194,9 +194,11 @@ void Stack::learn_gates(const Pose2& pose, TimeNs now, double speed) {
   const MissionParams& mp = params_.mission;
   // a learned gate whose posts the map no longer holds as big cones is
   // forgotten (and a better one may be learned in its place)
+  const std::vector<Cone> big = gate_cones();
+  const std::vector<Vec2> posts = find_posts(big, params_.gates);
   for (std::size_t i = gates_.size(); i-- > spec_.gates.size();)
-    if (!gate_still_seen(gates_[i])) gates_.erase(gates_.begin() + static_cast<std::ptrdiff_t>(i));
-  for (const Segment& g : find_gates(gate_cones(), params_.gates)) {
+    if (!gate_still_seen(gates_[i], posts)) gates_.erase(gates_.begin() + static_cast<std::ptrdiff_t>(i));
+  for (const Segment& g : find_gates(big, params_.gates)) {
     const Vec2 mid = (g.a + g.b) * 0.5;
     bool known = false;
     for (const Segment& k : gates_) known = known || distance((k.a + k.b) * 0.5, mid) < 3.0;
@@ -418,7 +420,7 @@ std::vector<Cone> Stack::gate_cones() const {
   return out;
 }
 
-bool Stack::gate_still_seen(const Segment& g) const {
+bool Stack::gate_still_seen(const Segment& g, const std::vector<Vec2>& posts) {
   // the map still holds both of this gate's posts (from its big orange
   // cones, as it was learned): a gate learned from cones the map later saw as
   // small (their early sightings misjudged their size) is no gate. The posts,
@@ -428,7 +430,7 @@ bool Stack::gate_still_seen(const Segment& g) const {
   // start straight taken for a big one, the finish line forgotten 0.6 s
   // before the car reached it, and the car drove on)
   bool a = false, b = false;
-  for (const Vec2& post : find_posts(gate_cones(), params_.gates)) {
+  for (const Vec2& post : posts) {
     a = a || distance(post, g.a) < 0.5;
     b = b || distance(post, g.b) < 0.5;
   }
@@ -469,7 +471,7 @@ void Stack::count_crossings(Vec2 base, TimeNs now, double speed) {
       const Segment& g = gates_[i];
       if (!crossing_right_to_left(*last_base_position_, base, g)) continue;
       // a learned gate must still be one when the car crosses it
-      if (i >= spec_.gates.size() && !gate_still_seen(g)) continue;
+      if (i >= spec_.gates.size() && !gate_still_seen(g, find_posts(gate_cones(), params_.gates))) continue;
       count_crossing(driven_, now, speed);
     }
   }

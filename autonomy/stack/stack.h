@@ -278,7 +278,8 @@ class Stack {
   // latest such crossing): the motion's direction there and the driven
   // distance (m)
   std::optional<std::pair<Vec2, double>> crossed_since_last(const Segment& g, Vec2 base) const;
-  bool gate_still_seen(const Segment& g) const;
+  // the map still holds both posts of g among `posts` (find_posts of gate_cones)
+  static bool gate_still_seen(const Segment& g, const std::vector<Vec2>& posts);
   // the map's big orange cones seen as big at least gate_min_observations
   // times (votes), what the gates are found in
   std::vector<Cone> gate_cones() const;
