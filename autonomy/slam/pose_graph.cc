@@ -164,7 +164,7 @@ bool PoseGraph::wants_node(const Pose2& odom_now) const {
          std::abs(wrap_angle(odom_now.yaw - last.yaw)) >= params_.node_spacing_yaw;
 }
 
-PoseGraph::Result PoseGraph::optimise() {
+PoseGraph::Result PoseGraph::optimise(int fixed_nodes) {
   Result res;
   if (poses_.empty()) {
     res.reason = "empty graph: no poses";
@@ -183,7 +183,8 @@ PoseGraph::Result PoseGraph::optimise() {
   ceres::Problem problem(po);
   // poses, then edges in node order, then observations in order of addition
   for (std::array<double, 3>& p : poses_) problem.AddParameterBlock(p.data(), 3);
-  problem.SetParameterBlockConstant(poses_[0].data());
+  const std::size_t fixed = std::clamp<std::size_t>(static_cast<std::size_t>(std::max(fixed_nodes, 1)), 1, poses_.size());
+  for (std::size_t i = 0; i < fixed; ++i) problem.SetParameterBlockConstant(poses_[i].data());
   for (std::size_t i = 1; i < poses_.size(); ++i) {
     const Edge& e = edges_[i];
     auto* cost = new ceres::AutoDiffCostFunction<MotionResidual, 3, 3, 3>(new MotionResidual(e.m.v, e.m.w, e.sqrt_info));

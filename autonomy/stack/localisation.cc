@@ -230,12 +230,15 @@ void Localisation::optimise_graph() {
     graph.add_landmark(s.id, it->second);
     graph.add_observation(s.node - first, s.id, s.point);
   }
-  const slam::PoseGraph::Result r = graph.optimise();
+  // (hold_optimised: the nodes up to the last solved closure's held)
+  const int held = params_.loop_closure.hold_optimised && optimised_until_ >= first ? optimised_until_ - first + 1 : 1;
+  const slam::PoseGraph::Result r = graph.optimise(held);
   if (!r.ok) {
     ++stats_.graph_failures;
     stats_.last_fault = "pose graph: " + r.reason;
   } else {
     for (int i = first; i < static_cast<int>(nodes_.size()); ++i) nodes_[i].estimate = graph.pose(i - first);
+    optimised_until_ = static_cast<int>(nodes_.size()) - 1;
     for (auto& [id, position] : map) {
       if (const std::optional<Vec2> l = graph.landmark(id)) position = *l;
     }
@@ -290,6 +293,7 @@ void Localisation::relocalise_on(const std::vector<slam::Observation>& obs) {
   nodes_.clear();
   sightings_.clear();
   closure_nodes_.clear();
+  optimised_until_ = -1;
 }
 
 double Localisation::odometry_variance() const {

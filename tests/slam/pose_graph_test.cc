@@ -407,14 +407,17 @@ Small small_problem() {
 }
 
 // the stacked whitened residuals of both kinds, written out again from the
-// paper's formulas; x: poses 1..4 (x, y, theta), then the 4 landmarks (x, y).
+// paper's formulas; x: poses held..4 (x, y, theta), then the 4 landmarks
+// (x, y); the poses before `held` at their odometry (held fixed).
 // The observations' whitening is diag(1/sr, 1/(r sb)) R(b)^T, another square
 // root of C^-1 than the graph's Cholesky factor: the same objective
-Eigen::VectorXd stacked(const Eigen::VectorXd& x, const Small& s, const PoseGraphParams& p) {
+Eigen::VectorXd stacked(const Eigen::VectorXd& x, const Small& s, const PoseGraphParams& p, int held = 1) {
   auto pose = [&](int i) -> Eigen::Vector3d {
-    if (i == 0) return {s.odometry[0].x, s.odometry[0].y, s.odometry[0].yaw};
-    return x.segment<3>(3 * (i - 1));
+    const Pose2& o = s.odometry[static_cast<std::size_t>(i)];
+    if (i < held) return {o.x, o.y, o.yaw};
+    return x.segment<3>(3 * (i - held));
   };
+  const int lm0 = 3 * (5 - held);  // the landmarks' first coordinate in x
   Eigen::VectorXd r(4 * 3 + static_cast<int>(s.obs.size()) * 2);
   int k = 0;
   for (int i = 1; i < 5; ++i) {
@@ -431,7 +434,7 @@ Eigen::VectorXd stacked(const Eigen::VectorXd& x, const Small& s, const PoseGrap
   }
   for (const Small::Obs& o : s.obs) {
     const Eigen::Vector3d P = pose(o.node);
-    const Eigen::Vector2d l = x.segment<2>(12 + 2 * o.lm);
+    const Eigen::Vector2d l = x.segment<2>(lm0 + 2 * o.lm);
     const double c = std::cos(P(2)), sn = std::sin(P(2));
     const Eigen::Vector2d e(c * (l(0) - P(0)) + sn * (l(1) - P(1)) - o.z.x, -sn * (l(0) - P(0)) + c * (l(1) - P(1)) - o.z.y);
     const double range = norm(o.z), b = angle_of(o.z);
@@ -443,16 +446,16 @@ Eigen::VectorXd stacked(const Eigen::VectorXd& x, const Small& s, const PoseGrap
   return r;
 }
 
-Eigen::VectorXd gauss_newton(Eigen::VectorXd x, const Small& s, const PoseGraphParams& p) {
+Eigen::VectorXd gauss_newton(Eigen::VectorXd x, const Small& s, const PoseGraphParams& p, int held = 1) {
   for (int it = 0; it < 100; ++it) {
-    const Eigen::VectorXd r = stacked(x, s, p);
+    const Eigen::VectorXd r = stacked(x, s, p, held);
     Eigen::MatrixXd J(r.size(), x.size());
     for (int j = 0; j < x.size(); ++j) {  // central differences
       const double h = 1e-6;
       Eigen::VectorXd xp = x, xm = x;
       xp(j) += h;
       xm(j) -= h;
-      J.col(j) = (stacked(xp, s, p) - stacked(xm, s, p)) / (2.0 * h);
+      J.col(j) = (stacked(xp, s, p, held) - stacked(xm, s, p, held)) / (2.0 * h);
     }
     const Eigen::VectorXd dx = (J.transpose() * J).ldlt().solve(-J.transpose() * r);
     x += dx;
@@ -507,6 +510,68 @@ TEST(PoseGraph, CeresSolutionEqualsADenseGaussNewton) {
   // the first pose is the gauge: untouched
   EXPECT_EQ(g.pose(0).x, s.odometry[0].x);
   EXPECT_EQ(g.pose(0).y, s.odometry[0].y);
+}
+
+// optimise(n) holds the first n nodes where they are and solves the rest
+// against them: the dense Gauss-Newton of the same objective with those
+// poses as constants
+TEST(PoseGraph, HeldNodesStayPutAndTheRestSolveAgainstThem) {
+  const Small s = small_problem();
+  PoseGraphParams p;
+  p.huber_scale = 0.0;
+  constexpr int kHeld = 3;
+  PoseGraph g(p), free(p);
+  Eigen::VectorXd x0(3 * (5 - kHeld) + 8);
+  for (int i = 0; i < 5; ++i) {
+    const Pose2& o = s.odometry[static_cast<std::size_t>(i)];
+    ASSERT_EQ(g.add_pose(o, o), i);
+    ASSERT_EQ(free.add_pose(o, o), i);
+    if (i >= kHeld) x0.segment<3>(3 * (i - kHeld)) << o.x, o.y, o.yaw;
+  }
+  const int lm0 = 3 * (5 - kHeld);
+  for (int j = 0; j < 4; ++j) {
+    const Vec2 l = s.lm_initial[static_cast<std::size_t>(j)];
+    ASSERT_TRUE(g.add_landmark(100 + j, l));
+    ASSERT_TRUE(free.add_landmark(100 + j, l));
+    x0.segment<2>(lm0 + 2 * j) << l.x, l.y;
+  }
+  for (const Small::Obs& o : s.obs) {
+    ASSERT_TRUE(g.add_observation(o.node, 100 + o.lm, o.z));
+    ASSERT_TRUE(free.add_observation(o.node, 100 + o.lm, o.z));
+  }
+  const PoseGraph::Result res = g.optimise(kHeld);
+  ASSERT_TRUE(res.ok) << res.reason;
+  ASSERT_TRUE(free.optimise().ok);
+  // the held nodes: as given, to the bit (the free solve moves them)
+  double moved_free = 0.0;
+  for (int i = 0; i < kHeld; ++i) {
+    const Pose2& o = s.odometry[static_cast<std::size_t>(i)];
+    EXPECT_EQ(g.pose(i).x, o.x) << "node " << i;
+    EXPECT_EQ(g.pose(i).y, o.y) << "node " << i;
+    EXPECT_EQ(g.pose(i).yaw, wrap_angle(o.yaw)) << "node " << i;
+    moved_free = std::max(moved_free, distance(free.pose(i).position(), o.position()));
+  }
+  EXPECT_GT(moved_free, 1e-3) << "the held nodes must be ones a free solve moves";
+  // the rest: the constrained minimum
+  const Eigen::VectorXd x = gauss_newton(x0, s, p, kHeld);
+  EXPECT_GT((x - x0).lpNorm<Eigen::Infinity>(), 0.01) << "the problem must move";
+  EXPECT_NEAR(res.final_cost, 0.5 * stacked(x, s, p, kHeld).squaredNorm(), 1e-9 * res.final_cost);
+  for (int i = kHeld; i < 5; ++i) {
+    EXPECT_NEAR(g.pose(i).x, x(3 * (i - kHeld)), 1e-6) << "pose " << i;
+    EXPECT_NEAR(g.pose(i).y, x(3 * (i - kHeld) + 1), 1e-6) << "pose " << i;
+    EXPECT_NEAR(wrap_angle(g.pose(i).yaw - x(3 * (i - kHeld) + 2)), 0.0, 1e-6) << "pose " << i;
+  }
+  for (int j = 0; j < 4; ++j) {
+    EXPECT_NEAR(g.landmark(100 + j)->x, x(lm0 + 2 * j), 1e-6) << "landmark " << j;
+    EXPECT_NEAR(g.landmark(100 + j)->y, x(lm0 + 2 * j + 1), 1e-6) << "landmark " << j;
+  }
+  // holding more nodes than there are holds them all: nothing to solve but the landmarks
+  PoseGraph all(p);
+  for (int i = 0; i < 5; ++i) all.add_pose(s.odometry[static_cast<std::size_t>(i)], s.odometry[static_cast<std::size_t>(i)]);
+  for (int j = 0; j < 4; ++j) all.add_landmark(100 + j, s.lm_initial[static_cast<std::size_t>(j)]);
+  for (const Small::Obs& o : s.obs) all.add_observation(o.node, 100 + o.lm, o.z);
+  ASSERT_TRUE(all.optimise(1000).ok);
+  for (int i = 0; i < 5; ++i) EXPECT_EQ(all.pose(i).x, s.odometry[static_cast<std::size_t>(i)].x) << "node " << i;
 }
 
 // ---- 5. determinism
