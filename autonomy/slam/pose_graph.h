@@ -39,7 +39,8 @@
 // heading, theta_p + kappa0 L/2 + kappa' L^2/6 to first order, the model says
 // theta_p + kappa0 L/2 + kappa' L^2/4: kappa' L^2 / 12 rad off, a lateral
 // kappa' L^3 / 12 (1 m nodes entering a 9 m hairpin over 3 m, kappa' = 0.04
-// /m^2: 3 mm against the edge's 1 cm std); (b) side slip: the model assumes
+// /m^2: 3 mm against the edge's 1 cm std; 2 m nodes: 27 mm against 2 cm,
+// where the heading spacing does not cut the edge shorter first); (b) side slip: the model assumes
 // the base moves along its heading, a mean slip angle beta over the edge
 // puts the chord beta off (at the rear axle in a steady corner 1-2 deg:
 // 2-3 cm per metre) — the edge's std must cover it, or the base be put

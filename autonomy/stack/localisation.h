@@ -82,9 +82,9 @@ struct LoopClosureParams {
   // first node is held: the gauge). Measured (2026-11-29, seven shipped
   // trackdrives x 2 seeds and the noisy CI scenario x 8 seeds, with 2 m
   // nodes): map RMSE 0.065 m mean against 0.093 (every clean track better,
-  // FSG 2024 0.030 against 0.072), ATE RMS 0.100 against 0.110, one run's 3
-  // cones hit against none, the solves' time 11.5 s against 36.6 s (with 1
-  // m nodes alone: 0.088 m, 29.6 s). Re-solving the older lap from the
+  // FSG 2024 0.030 against 0.072), ATE RMS 0.100 against 0.110, cones hit
+  // in none of the runs against 3 in one, the solves' time 11.5 s against
+  // 36.6 s (held, with 1 m nodes: 0.088 m, 29.6 s). Re-solving the older lap from the
   // front end's drifted estimates let the whole window turn about its first
   // node, a map that moved under the car at each closure
   bool hold_optimised = true;
