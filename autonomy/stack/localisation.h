@@ -84,9 +84,9 @@ struct LoopClosureParams {
   // nodes): map RMSE 0.065 m mean against 0.093 (every clean track better,
   // FSG 2024 0.030 against 0.072), ATE RMS 0.100 against 0.110, cones hit
   // in none of the runs against 3 in one, the solves' time 11.5 s against
-  // 36.6 s (held, with 1 m nodes: 0.088 m, 29.6 s). Re-solving the older lap from the
-  // front end's drifted estimates let the whole window turn about its first
-  // node, a map that moved under the car at each closure
+  // 36.6 s (held, with 1 m nodes: 0.088 m, 29.6 s). Re-solving the older
+  // lap from the front end's drifted estimates let the whole window turn
+  // about its first node, a map that moved under the car at each closure
   bool hold_optimised = true;
 
   template <class V>

@@ -331,6 +331,25 @@ Scenario noisy_graph_trackdrive() {
   return s;
 }
 
+// the first moment a run's lap was locked (-1 s: not by t_max) and the
+// loop closures by then (-1: none locked)
+struct LapLock {
+  double at = -1.0;
+  int closures = -1;
+};
+// steps the run until it is done or t_max, noting when its lap was locked
+LapLock step_until(const SimModel& model, SimState& state, double t_max) {
+  LapLock lock;
+  while (!state.done && state.t < t_max) {
+    step(model, state);
+    if (lock.at < 0.0 && state.stack.telemetry().lap_locked) {
+      lock.at = state.t;
+      lock.closures = state.stack.localisation()->stats().loop_closures;
+    }
+  }
+  return lock;
+}
+
 // a trackdrive on the pose graph keeps the lap it plans on the map the first
 // loop closure optimised, not on the first lap's map just before it (whose
 // drift the closure then takes out of the map the car localises in): on the
@@ -346,14 +365,9 @@ TEST(Simulation, ATrackdriveLocksItsLapOnTheMapTheLoopClosureOptimised) {
     const world::TrackModel track = world::build_track(load_track_file(s.track_path));
     const SimModel model = compile_model(s, track);
     SimState state(model);
-    int closures_at_lock = -1;
-    while (!state.done && state.t < 45.0) {
-      step(model, state);
-      if (closures_at_lock < 0 && state.stack.telemetry().lap_locked)
-        closures_at_lock = state.stack.localisation()->stats().loop_closures;
-    }
-    ASSERT_GE(closures_at_lock, 0) << seed << ": no lap locked by 45 s";
-    EXPECT_GE(closures_at_lock, 1) << seed;
+    const LapLock lock = step_until(model, state, 45.0);
+    ASSERT_GE(lock.closures, 0) << seed << ": no lap locked by 45 s";
+    EXPECT_GE(lock.closures, 1) << seed;
     EXPECT_EQ(state.stack.telemetry().fallbacks, 0) << seed;
     // the locked lap against the true cones
     double nearest = std::numeric_limits<double>::infinity();
@@ -377,12 +391,7 @@ TEST(Simulation, ATrackdriveWhoseLoopNeverClosesStillLocksItsLap) {
   const world::TrackModel track = world::build_track(load_track_file(s.track_path));
   const SimModel model = compile_model(s, track);
   SimState state(model);
-  double locked_at = -1.0;
-  while (!state.done && state.t < 50.0) {
-    step(model, state);
-    if (locked_at < 0.0 && state.stack.telemetry().lap_locked) locked_at = state.t;
-  }
-  ASSERT_GT(locked_at, 0.0) << "no lap locked by 50 s";
+  ASSERT_GT(step_until(model, state, 50.0).at, 0.0) << "no lap locked by 50 s";
   EXPECT_EQ(state.stack.localisation()->stats().loop_closures, 0);
   EXPECT_EQ(state.stack.telemetry().fallbacks, 0);
   EXPECT_TRUE(state.stack.trajectory().closed);
