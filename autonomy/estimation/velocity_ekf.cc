@@ -182,10 +182,14 @@ void VelocityEkf::update(double innovation, const Vector& H, double var) {
   const Vector PH = P_ * H;
   const double S = H.dot(PH) + var;
   if (!(S > 0.0)) return;
-  const Vector K = PH / S;
+  // the position is left as integrated (see the header): its gain rows are
+  // zero, and with a gain that is not the optimal one the covariance takes
+  // the Joseph form
+  Vector K = PH / S;
+  K(kX) = K(kY) = 0.0;
   x_ += K * innovation;
-  // P - K S K^T = P - PH PH^T / S: symmetric by construction
-  P_ -= K * PH.transpose();
+  const Matrix IKH = Matrix::Identity() - K * H.transpose();
+  P_ = IKH * P_ * IKH.transpose() + var * K * K.transpose();
   P_ = 0.5 * (P_ + P_.transpose()).eval();
   x_(kYaw) = wrap_angle(x_(kYaw));
 }
@@ -319,10 +323,13 @@ int VelocityEkf::wheel_update(WheelModel w, const std::array<bool, 4>& use) {
   const Eigen::Matrix4d S = Hu * PHt + w.C;
   const Eigen::LLT<Eigen::Matrix4d> llt(S);
   if (llt.info() != Eigen::Success) return used;
-  // K = P H^T S^-1; P - K S K^T = P - P H^T S^-1 H P
-  const Eigen::Matrix<double, 4, 9> SinvHP = llt.solve(PHt.transpose());
-  x_ += SinvHP.transpose() * nuu;
-  P_ -= PHt * SinvHP;
+  // K = P H^T S^-1 with the position's rows zero (update()'s Joseph form)
+  Eigen::Matrix<double, 9, 4> K = llt.solve(PHt.transpose()).transpose();
+  K.row(kX).setZero();
+  K.row(kY).setZero();
+  x_ += K * nuu;
+  const Matrix IKH = Matrix::Identity() - K * Hu;
+  P_ = IKH * P_ * IKH.transpose() + K * w.C * K.transpose();
   P_ = 0.5 * (P_ + P_.transpose()).eval();
   x_(kYaw) = wrap_angle(x_(kYaw));
   return used;
