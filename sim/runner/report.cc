@@ -52,6 +52,9 @@ std::vector<std::string> check_expectations(const Expectations& e, const RunResu
   if (!r.stack_remote && e.ate_rms_max && r.slam.ate_rms > *e.ate_rms_max) {
     failed.push_back("ATE rms: expected at most " + fixed(*e.ate_rms_max, 3) + " m, got " + fixed(r.slam.ate_rms, 3) + " m");
   }
+  if (!r.stack_remote && e.ate_max_max && r.slam.ate_max > *e.ate_max_max) {
+    failed.push_back("ATE max: expected at most " + fixed(*e.ate_max_max, 3) + " m, got " + fixed(r.slam.ate_max, 3) + " m");
+  }
   if (!r.stack_remote && e.map_recall_min && r.slam.map.recall < *e.map_recall_min) {
     failed.push_back("map recall: expected at least " + fixed(*e.map_recall_min, 3) + ", got " + fixed(r.slam.map.recall, 3));
   }
@@ -103,6 +106,7 @@ std::vector<std::string> check_expectations(const Expectations& e, const RunResu
     const std::pair<bool, const char*> inside[] = {{e.lateral_rms_max.has_value(), "lateral rms"},
                                                    {e.lateral_error_max.has_value(), "lateral max"},
                                                    {e.ate_rms_max.has_value(), "ATE rms"},
+                                                   {e.ate_max_max.has_value(), "ATE max"},
                                                    {e.map_recall_min.has_value(), "map recall"},
                                                    {e.fallbacks_max.has_value(), "fallbacks"}};
     for (const auto& [set, what] : inside)

@@ -131,6 +131,7 @@ struct Expectations {
   std::optional<double> lateral_error_max;
   std::optional<int> fallbacks_max;
   std::optional<double> ate_rms_max;
+  std::optional<double> ate_max_max;
   std::optional<double> map_recall_min;
   std::optional<double> best_above_limit_max;
   std::optional<bool> emergency;
@@ -153,6 +154,7 @@ struct Expectations {
     v(PADDOCK_PARAM(lateral_error_max), {"m", positive, "largest lateral error at most"});
     v(PADDOCK_PARAM(fallbacks_max), {"", count, "safe-stop control cycles, at most"});
     v(PADDOCK_PARAM(ate_rms_max), {"m", positive, "the state estimate's RMS position error (ATE) at most"});
+    v(PADDOCK_PARAM(ate_max_max), {"m", positive, "the state estimate's largest position error (ATE max) at most"});
     v(PADDOCK_PARAM(map_recall_min), {"", params::fraction(), "the final map's recall (true cones along the path it holds) at least"});
     v(PADDOCK_PARAM(best_above_limit_max), {"", positive, "the best lap's share above the car's limit lap (circuits), at most"});
     v(PADDOCK_PARAM(emergency), "the car goes to AS Emergency (the EBS brakes it to rest)");

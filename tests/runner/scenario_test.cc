@@ -12,12 +12,15 @@
 
 #include "sim/runner/files.h"
 #include "sim/runner/ini.h"
+#include "sim/runner/report.h"
 #include "sim/runner/schema.h"
+#include "sim/runner/simulation.h"
 
 namespace paddock::runner {
 namespace {
 
 namespace fs = std::filesystem;
+using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
 const std::string kRoot = PADDOCK_SOURCE_DIR;
@@ -384,6 +387,25 @@ TEST(VehicleFile, ACarTheDefaultStepCannotIntegrateIsRejected) {
       EXPECT_EQ(vehicle_error(p), "(no error)") << c.name;
     }
   }
+}
+
+// [expect] ate_max_max holds the estimate's worst moment, not only its
+// RMS: the run's largest ATE against the bound, and with the stack in the
+// car binary (where the estimate stays) a failure that says it was not
+// measured
+TEST(Expectations, AteMaxIsTheEstimatesWorstMoment) {
+  RunResult r;
+  r.slam.ate_rms = 0.05;
+  r.slam.ate_max = 0.5;
+  Expectations e;
+  e.ate_max_max = 0.6;
+  EXPECT_TRUE(check_expectations(e, r).empty());
+  e.ate_max_max = 0.4;
+  EXPECT_THAT(check_expectations(e, r), ElementsAre("ATE max: expected at most 0.400 m, got 0.500 m"));
+  r.stack_remote = true;
+  r.slam.ate_max = 0.0;
+  EXPECT_THAT(check_expectations(e, r),
+              ElementsAre("ATE max: not measured: the stack ran in the car binary (transport = udp)"));
 }
 
 }  // namespace
