@@ -264,12 +264,29 @@ std::string Scenario::check() const {
       autonomy.perception == stack::PerceptionMode::GroundTruth)
     return "autonomy.slam = lio or lio_graph needs the LiDAR's scans: autonomy.perception = lidar or lidar_camera";
   const double limit = vehicle::stable_step_limit(vehicle);
-  if (1.0 / sim.physics_rate <= limit) {
-    return sim.physics_rate % vcu.status_rate == 0 ? "" : "sim.physics_rate must be a whole multiple of vcu.status_rate";
+  if (1.0 / sim.physics_rate > limit) {
+    return "sim.physics_rate must be at least " + std::to_string(static_cast<int>(std::ceil(1.0 / limit))) +
+           " Hz for this vehicle (its tyre modes need a step of at most " + params::number(std::floor(limit * 1e4) / 10.0) +
+           " ms to integrate stably)";
   }
-  return "sim.physics_rate must be at least " + std::to_string(static_cast<int>(std::ceil(1.0 / limit))) +
-         " Hz for this vehicle (its tyre modes need a step of at most " + params::number(std::floor(limit * 1e4) / 10.0) +
-         " ms to integrate stably)";
+  if (sim.physics_rate % vcu.status_rate != 0) return "sim.physics_rate must be a whole multiple of vcu.status_rate";
+  // each sensor samples every physics_rate / rate steps: a rate that does
+  // not divide the physics rate would be sampled at another (rounded) one
+  const std::pair<const char*, double> sampled[] = {{"[imu] rate", imu.rate},
+                                                    {"[wheel_speeds] rate", wheel_speeds.rate},
+                                                    {"[steering_sensor] rate", steering_sensor.rate},
+                                                    {"[cone_sensor] rate", cone_sensor.rate}};
+  for (const auto& [key, rate] : sampled) {
+    const double steps = static_cast<double>(sim.physics_rate) / rate;
+    const double whole = std::max(1.0, std::round(steps));
+    if (std::abs(steps - whole) > 1e-9 * whole) {
+      return "sim.physics_rate (" + params::number(sim.physics_rate) + " Hz) must be a whole multiple of " + key + " (" +
+             params::number(rate) + " Hz): it would be sampled every " +
+             (whole > 1.0 ? params::number(whole) + " steps" : std::string("step")) + ", at " +
+             params::number(std::round(10.0 * sim.physics_rate / whole) / 10.0) + " Hz";
+    }
+  }
+  return "";
 }
 
 std::vector<std::string> thread_overrides(int n, const Scenario& s) {

@@ -104,7 +104,7 @@ struct SimSection {
 
   template <class V>
   void visit(V& v) {
-    v(PADDOCK_PARAM(physics_rate), {"Hz", params::in(1, 100000), "vehicle and world integration rate"});
+    v(PADDOCK_PARAM(physics_rate), {"Hz", params::in(1, 100000), "vehicle and world integration rate: a whole multiple of the control, log, VCU and sensor rates"});
     v(PADDOCK_PARAM(control_rate), {"Hz", params::in(1, 100000), "the stack's cycle (and the state estimate's rate)"});
     v(PADDOCK_PARAM(log_rate), {"Hz", params::in(1, 100000), "rows of log.csv, and the event's off-course checks"});
     v(PADDOCK_PARAM(snapshot_time), {"s", params::in(0.0, 1e6), "the first LiDAR scan after this is kept for the perception figures"});

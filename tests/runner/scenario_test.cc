@@ -126,6 +126,34 @@ TEST(Scenario, OverridesWinAndAreChecked) {
   EXPECT_THAT(msg({"scenario.seed=1", "control.nokey=1"}), HasSubstr("--set:2: unknown key 'nokey' in [control]"));
 }
 
+// every sensor samples a whole number of physics steps apart: a physics
+// rate its rate does not divide is refused, naming both (before, 500 Hz
+// physics silently sampled the 200 Hz IMU every 3 steps, at 166.7 Hz)
+TEST(Scenario, ASensorRateThePhysicsRateDoesNotDivideIsRefused) {
+  auto msg = [](const std::vector<std::string>& o) {
+    try {
+      load_scenario(kDefault, o);
+    } catch (const UserError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(no error)");
+  };
+  EXPECT_THAT(msg({"sim.physics_rate=500"}),
+              HasSubstr("physics_rate (500 Hz) must be a whole multiple of [imu] rate (200 Hz): it would be sampled "
+                        "every 3 steps, at 166.7 Hz"));
+  EXPECT_THAT(msg({"wheel_speeds.rate=300"}), HasSubstr("must be a whole multiple of [wheel_speeds] rate (300 Hz)"));
+  EXPECT_THAT(msg({"steering_sensor.rate=3000"}),
+              HasSubstr("[steering_sensor] rate (3000 Hz): it would be sampled every step, at 1000 Hz"));
+  EXPECT_THAT(msg({"cone_sensor.rate=7"}), HasSubstr("[cone_sensor] rate (7 Hz)"));
+  // rates that divide it: each sensor every whole number of steps
+  EXPECT_EQ(msg({"sim.physics_rate=400"}), "(no error)");
+  EXPECT_EQ(msg({"cone_sensor.rate=12.5", "imu.rate=250"}), "(no error)");
+  const SimModel m = compile_model(load_scenario(kDefault, {"sim.physics_rate=400"}),
+                                   world::build_track(load_track_file(load_scenario(kDefault).track_path)));
+  EXPECT_EQ(m.every.imu, 2);
+  EXPECT_EQ(m.every.wheel_speeds, 4);
+}
+
 TEST(Scenario, DetectorKeysSetTheSimulatedDetectorNode) {
   // [detector] is the simulator's detector node (sim/sensors), not the stack's
   const Scenario s = load_scenario(kDefault, {"detector.p_miss_near=0.1", "detector.box_jitter=0.05"});
