@@ -109,45 +109,39 @@ TEST_F(ScenarioFile, MissingTrackKeyIsNamed) {
   EXPECT_THAT(error_of(p), HasSubstr("[scenario] track is not set"));
 }
 
+// the error of loading the default scenario with these overrides ("(no error)": none)
+std::string override_error(const std::vector<std::string>& overrides) {
+  try {
+    load_scenario(kDefault, overrides);
+  } catch (const UserError& e) {
+    return std::string(e.what());
+  }
+  return std::string("(no error)");
+}
+
 TEST(Scenario, OverridesWinAndAreChecked) {
   const Scenario s = load_scenario(kDefault, {"control.lateral=stanley", "scenario.seed = 7"});
   EXPECT_EQ(s.control.lateral, control::LateralMode::Stanley);
   EXPECT_EQ(s.scenario.seed, 7u);
-  auto msg = [](const std::vector<std::string>& o) {
-    try {
-      load_scenario(kDefault, o);
-    } catch (const UserError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
-  };
-  EXPECT_THAT(msg({"control.lateral=mpc"}), HasSubstr("--set:1: [control] lateral = 'mpc' is not known"));
-  EXPECT_THAT(msg({"seed=3", }), HasSubstr("--set seed=3: expected section.key=value"));
-  EXPECT_THAT(msg({"scenario.seed=1", "control.nokey=1"}), HasSubstr("--set:2: unknown key 'nokey' in [control]"));
+  EXPECT_THAT(override_error({"control.lateral=mpc"}), HasSubstr("--set:1: [control] lateral = 'mpc' is not known"));
+  EXPECT_THAT(override_error({"seed=3", }), HasSubstr("--set seed=3: expected section.key=value"));
+  EXPECT_THAT(override_error({"scenario.seed=1", "control.nokey=1"}), HasSubstr("--set:2: unknown key 'nokey' in [control]"));
 }
 
 // every sensor samples a whole number of physics steps apart: a physics
 // rate its rate does not divide is refused, naming both (before, 500 Hz
 // physics silently sampled the 200 Hz IMU every 3 steps, at 166.7 Hz)
 TEST(Scenario, ASensorRateThePhysicsRateDoesNotDivideIsRefused) {
-  auto msg = [](const std::vector<std::string>& o) {
-    try {
-      load_scenario(kDefault, o);
-    } catch (const UserError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(no error)");
-  };
-  EXPECT_THAT(msg({"sim.physics_rate=500"}),
+  EXPECT_THAT(override_error({"sim.physics_rate=500"}),
               HasSubstr("physics_rate (500 Hz) must be a whole multiple of [imu] rate (200 Hz): it would be sampled "
                         "every 3 steps, at 166.7 Hz"));
-  EXPECT_THAT(msg({"wheel_speeds.rate=300"}), HasSubstr("must be a whole multiple of [wheel_speeds] rate (300 Hz)"));
-  EXPECT_THAT(msg({"steering_sensor.rate=3000"}),
+  EXPECT_THAT(override_error({"wheel_speeds.rate=300"}), HasSubstr("must be a whole multiple of [wheel_speeds] rate (300 Hz)"));
+  EXPECT_THAT(override_error({"steering_sensor.rate=3000"}),
               HasSubstr("[steering_sensor] rate (3000 Hz): it would be sampled every step, at 1000 Hz"));
-  EXPECT_THAT(msg({"cone_sensor.rate=7"}), HasSubstr("[cone_sensor] rate (7 Hz)"));
+  EXPECT_THAT(override_error({"cone_sensor.rate=7"}), HasSubstr("[cone_sensor] rate (7 Hz)"));
   // rates that divide it: each sensor every whole number of steps
-  EXPECT_EQ(msg({"sim.physics_rate=400"}), "(no error)");
-  EXPECT_EQ(msg({"cone_sensor.rate=12.5", "imu.rate=250"}), "(no error)");
+  EXPECT_EQ(override_error({"sim.physics_rate=400"}), "(no error)");
+  EXPECT_EQ(override_error({"cone_sensor.rate=12.5", "imu.rate=250"}), "(no error)");
   const SimModel m = compile_model(load_scenario(kDefault, {"sim.physics_rate=400"}),
                                    world::build_track(load_track_file(load_scenario(kDefault).track_path)));
   EXPECT_EQ(m.every.imu, 2);
