@@ -50,19 +50,52 @@ bool triangulate_and_search(const std::vector<Cone>& cone_map, const Pose2& vehi
 // mapped cone within kBoundaryReach of its centreline, on the side of it
 // where it lies, in the order of its projection along the path (the cones
 // the path passes: the nearest part of the path claims a cone, so a
-// neighbouring leg's cones are not this one's)
+// neighbouring leg's cones are not this one's); and both cones of every
+// edge of the triangulation the path crosses, however far from it they
+// stand. A path that cuts the fan of rungs round a tight apex (a long step
+// of the search across them, then smoothed) passes the fan's outer cones
+// more than kBoundaryReach away, yet it crosses the track they bound: left
+// out, the racing line had no outer boundary there and was held to the
+// chord (FSG 2019 autocross, the 90-degree left at (-5, -20): a kink of
+// 0.5 1/m in the first lap, on every seed)
 constexpr double kBoundaryReach = 3.5;  // m: half the widest FS track and a cone's offset
+
+// a and b strictly on opposite sides of the line through c-d, and c and d of a-b's
+bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
+  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+  return ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0)) && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0));
+}
 
 void path_boundaries(const std::vector<Vec2>& path, bool closed, const std::vector<Cone>& cones,
                      const Triangulation& tri, std::vector<Vec2>& left, std::vector<Vec2>& right) {
-  std::vector<std::pair<double, Vec2>> l, r;
+  std::vector<Projection> on(cones.size());
+  std::vector<char> taken(cones.size(), 0);
   for (std::size_t i = 0; i < cones.size(); ++i) {
-    const Cone& c = cones[i];
     // a doubled cone once (the triangulation merged it), a non-finite one never
     if (i >= tri.representative.size() || tri.representative[i] != i) continue;
-    const Projection p = project(path, closed, c.position);
-    if (p.distance > kBoundaryReach) continue;
-    (p.signed_offset > 0.0 ? l : r).push_back({p.s, c.position});
+    on[i] = project(path, closed, cones[i].position);
+    taken[i] = on[i].distance <= kBoundaryReach;
+  }
+  // an edge with a cone beyond the reach, its cones either side of the path:
+  // a candidate, crossed if one of the path's segments crosses it
+  const std::size_t n = path.size(), segments = closed ? n : n - 1;
+  for (const TriEdge& e : tri.edges) {
+    if (e.a >= cones.size() || e.b >= cones.size() || (taken[e.a] && taken[e.b])) continue;
+    if (tri.representative[e.a] != e.a || tri.representative[e.b] != e.b) continue;
+    if ((on[e.a].signed_offset > 0.0) == (on[e.b].signed_offset > 0.0)) continue;
+    const Vec2 a = cones[e.a].position, b = cones[e.b].position;
+    for (std::size_t k = 0; k < segments; ++k) {
+      if (segments_cross(path[k], path[(k + 1) % n], a, b)) {
+        taken[e.a] = taken[e.b] = 1;
+        break;
+      }
+    }
+  }
+  std::vector<std::pair<double, Vec2>> l, r;
+  for (std::size_t i = 0; i < cones.size(); ++i) {
+    if (!taken[i]) continue;
+    (on[i].signed_offset > 0.0 ? l : r).push_back({on[i].s, cones[i].position});
   }
   const auto by_s = [](const auto& a, const auto& b) { return a.first < b.first; };
   std::stable_sort(l.begin(), l.end(), by_s);

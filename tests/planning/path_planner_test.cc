@@ -537,6 +537,71 @@ TEST(PathPlannerTracks, PartialMapRacesAsFarAsItIsKnown) {
 
 // ---- abnormal maps: no trajectory and a reason ----------------------------------------
 
+// the racing line's boundaries of a lap whose path cuts a corner: a
+// rectangle 6 m wide with cones every 3 m, driven anticlockwise (blue
+// inside, on the left), its path cutting the corner at (60, 0) by a chord
+// from (56, 0) to (60, 4). The chord passes 1.4 m from the inner corner
+// cone and 4.9 m from the outer cones either side of the outer corner,
+// beyond the 3.5 m within which the path claims a cone; yet it crosses the
+// rungs from the inner corner to them, so they bound it, on the right; and
+// round that corner every cone bounds it on its own side. (The outer corner
+// itself, 7.1 m off, is no rung's end: the two cones beside it close the
+// triangulation there)
+TEST(PathPlanner, ACutCornersOuterConesStillBoundItsRacingLine) {
+  std::vector<Cone> cones;
+  auto ring = [&](double x0, double y0, double x1, double y1, ConeColor c) {
+    const std::vector<Vec2> corners{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Vec2 a = corners[k], b = corners[(k + 1) % 4];
+      const int n = static_cast<int>(std::lround(distance(a, b) / 3.0));
+      for (int i = 0; i < n; ++i) cones.push_back({a + (b - a) * (static_cast<double>(i) / n), c});
+    }
+  };
+  ring(3.0, 3.0, 57.0, 27.0, ConeColor::Blue);      // inside
+  ring(-3.0, -3.0, 63.0, 33.0, ConeColor::Yellow);  // outside
+  PlanResult lap;
+  lap.status = PlanStatus::Ok;
+  lap.closed = true;
+  lap.triangulation = triangulate(cones);
+  ASSERT_TRUE(lap.triangulation.ok());
+  // the centreline every 1 m, anticlockwise, the corner at (60, 0) cut
+  const std::vector<Vec2> centre{{0.0, 0.0}, {60.0, 0.0}, {60.0, 30.0}, {0.0, 30.0}};
+  for (std::size_t k = 0; k < 4; ++k) {
+    const Vec2 a = centre[k], b = centre[(k + 1) % 4];
+    for (int i = 0; i < static_cast<int>(distance(a, b)); ++i) {
+      const Vec2 q = a + (b - a) * (i / distance(a, b));
+      if (distance(q, {60.0, 0.0}) < 4.0 - 1e-9) continue;
+      lap.smoothed.push_back(q);
+    }
+  }
+  const std::vector<Vec2> outer{{60.0, -3.0}, {63.0, 0.0}};
+  for (const Vec2& q : outer) ASSERT_GT(project(lap.smoothed, true, q).distance, 4.5);
+  PathPlannerParams p;
+  plan_racing_line(lap, cones, p);  // the boundaries come first, whatever the line does
+  auto has = [](const std::vector<Vec2>& v, Vec2 q) {
+    return std::any_of(v.begin(), v.end(), [&](Vec2 x) { return distance(x, q) < 1e-9; });
+  };
+  for (const Vec2& q : outer) EXPECT_TRUE(has(lap.right_boundary, q)) << q.x << " " << q.y;
+  EXPECT_TRUE(has(lap.left_boundary, Vec2{57.0, 3.0}));
+  // round the cut corner: the inner cones on the left, the outer on the right, each once
+  auto near_cut = [](Vec2 q) { return q.x > 45.0 && q.y < 15.0; };
+  auto inside = [](Vec2 q) { return q.x < 59.0 && q.y > 1.0; };
+  std::size_t round_corner = 0;
+  for (const Cone& c : cones) round_corner += near_cut(c.position) && distance(c.position, {63.0, -3.0}) > 1e-9;
+  std::size_t bounding = 0;
+  for (const Vec2& q : lap.left_boundary) {
+    if (!near_cut(q)) continue;
+    EXPECT_TRUE(inside(q)) << q.x << " " << q.y;
+    ++bounding;
+  }
+  for (const Vec2& q : lap.right_boundary) {
+    if (!near_cut(q)) continue;
+    EXPECT_FALSE(inside(q)) << q.x << " " << q.y;
+    ++bounding;
+  }
+  EXPECT_EQ(bounding, round_corner);
+}
+
 TEST(PathPlanner, AbnormalInputsGiveNoTrajectoryAndAReason) {
   const Pose2 start{0.0, 0.0, 0.0};
   auto expect_no_plan = [&](const std::vector<Cone>& cones, PlanStatus want, const char* what) {
