@@ -4,6 +4,8 @@
 #include <cassert>
 #include <cmath>
 
+#include "autonomy/common/simd_math.h"
+
 namespace paddock::vehicle {
 
 // ---------------------------------------------------------------------------
@@ -39,11 +41,6 @@ constexpr double kPlausibilityReset = 0.05;
 constexpr double kRegenOff = 5.0 / 3.6;
 constexpr double kRegenFull = 10.0 / 3.6;
 
-// Pacejka's curve without shifts: g(X) = sin(C atan(X - E (X - atan X))); g'(0) = C
-inline double mf_shape(const VehicleParams& p, double x) {
-  return std::sin(p.tyre_c * std::atan(x - p.tyre_e * (x - std::atan(x))));
-}
-
 inline double sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
 
 // a wheel's share of the drive torque: the axle's, split equally left and right
@@ -62,13 +59,33 @@ double load_factor(const VehicleParams& p, double fz) {
   return std::max(0.0, 1.0 + p.tyre_load_sensitivity * (fz / p.tyre_load_nominal - 1.0));
 }
 
+namespace {
+
+using simd::D4;
+
+// four tyres' forces at once (lane i: wheel i), see tyre_force; the load
+// factor's lanes out in mu (times fz: the friction the wheel has). Pacejka's
+// curve without shifts, g(X) = sin(C atan(X - E (X - atan X))), g'(0) = C
+PADDOCK_SIMD_INLINE void tyre_lanes(const VehicleParams& p, D4 kappa, D4 alpha, D4 fz, D4& fx, D4& fy, D4& mu) {
+  const D4 xs = p.tyre_bx * kappa;
+  const D4 ys = p.tyre_b * alpha;
+  const D4 x2 = xs * xs + ys * ys;
+  const D4 x = {std::sqrt(x2[0]), std::sqrt(x2[1]), std::sqrt(x2[2]), std::sqrt(x2[3])};
+  const D4 g = simd::sin(p.tyre_c * simd::atan(x - p.tyre_e * (x - simd::atan(x))));
+  // load_factor's max(0, .) as std::max(0, v): v unless 0 < v is false
+  const D4 lf = 1.0 + p.tyre_load_sensitivity * (fz / p.tyre_load_nominal - 1.0);
+  mu = simd::select(0.0 < lf, lf, simd::splat(0.0)) * fz;
+  const D4 k = simd::select((x == 0.0) | (fz <= 0.0), simd::splat(0.0), mu * g / x);
+  fx = p.tyre_dx * k * xs;
+  fy = -p.tyre_d * k * ys;
+}
+
+}  // namespace
+
 TyreForce tyre_force(const VehicleParams& p, double kappa, double alpha, double fz) {
-  const double xs = p.tyre_bx * kappa;
-  const double ys = p.tyre_b * alpha;
-  const double x = std::sqrt(xs * xs + ys * ys);
-  if (x == 0.0 || fz <= 0.0) return {};
-  const double k = load_factor(p, fz) * fz * mf_shape(p, x) / x;
-  return {p.tyre_dx * k * xs, -p.tyre_d * k * ys};
+  D4 fx, fy, mu;
+  tyre_lanes(p, simd::splat(kappa), simd::splat(alpha), simd::splat(fz), fx, fy, mu);
+  return {fx[0], fy[0]};
 }
 
 double tyre_lateral_force(const VehicleParams& p, double alpha, double fz) { return tyre_force(p, 0.0, alpha, fz).fy; }
@@ -238,27 +255,16 @@ double motor_torques(const Model& m, const X& s, std::array<double, 4>& torque, 
   return p_drive * k_drive * m.inv_eta + p_regen * k_regen * m.eta;
 }
 
-// the force of wheel i's tyre (wheel frame) at load fz, its contact moving at
-// (vcx, vcy) and slipping at v_slip = omega r - vcx: the deflections' force,
-// and below kLowSpeed the damper on the slip velocities. The damper adds to
-// the spring up to the friction the wheel has: it still opposes the slip
-// (dissipates), never beyond what the road takes
-inline TyreForce contact_force(const Model& m, const X& s, std::size_t i, double fz, double vcx, double v_slip,
-                               double vcy) {
-  const VehicleParams& p = *m.p;
-  TyreForce f = tyre_force(p, s.ux[i] * m.inv_sigma_x, std::atan(s.uy[i] * m.inv_sigma_y), fz);
-  const double low = 1.0 - std::abs(vcx) * (1.0 / kLowSpeed);
-  if (low > 0.0) {
-    const double k = low * std::min(1.0, fz * m.inv_fz_static[i]);
-    const double mu = load_factor(p, fz) * fz;
-    f.fx = std::clamp(f.fx + k * m.c_x[i] * v_slip, -p.tyre_dx * mu, p.tyre_dx * mu);
-    f.fy = std::clamp(f.fy - k * m.c_y[i] * vcy, -p.tyre_d * mu, p.tyre_d * mu);
-  }
-  return f;
+// std::min(a, b), std::clamp(v, lo, hi), lane by lane and alike for NaN
+PADDOCK_SIMD_INLINE D4 min_lanes(D4 a, D4 b) { return simd::select(b < a, b, a); }
+PADDOCK_SIMD_INLINE D4 clamp_lanes(D4 v, D4 lo, D4 hi) {
+  return simd::select(v < lo, lo, simd::select(hi < v, hi, v));
 }
 
-// the state derivative (the wheels' spin with the friction decided in step())
-Deriv derivative(const Model& m, const X& s) {
+// the state derivative (the wheels' spin with the friction decided in step()):
+// the four tyres as the four lanes of one vector (simd_math.h); built twice,
+// for AVX2 and for baseline x86-64, with the same result (see below)
+PADDOCK_SIMD_INLINE Deriv derivative_body(const Model& m, const X& s) {
   const VehicleParams& p = *m.p;
   Deriv out{};
   X& d = out.d;
@@ -277,28 +283,56 @@ Deriv derivative(const Model& m, const X& s) {
   out.power = motor_torques(m, s, t_drive, regen);
   d.energy = out.power;
 
-  const double sd = std::sin(s.steer);
-  const double cd = std::cos(s.steer);
-  double fx_sum = 0.0, fy_sum = 0.0, mz = 0.0;
+  // the steering's and the heading's sine and cosine in one go
+  D4 sines, cosines;
+  simd::sincos(D4{s.steer, s.yaw, 0.0, 0.0}, sines, cosines);
+  const double sd = sines[0], cd = cosines[0];
+
+  // each contact point's velocity, body frame then wheel frame; sideways,
+  // the axle centre's (the single-track model: in effect Ackermann steering,
+  // the two wheels of an axle share its slip angle); its load
+  alignas(32) double c[4], sn[4], vcx[4], vcy[4], fz[4], v_slip[4];
   for (std::size_t i = 0; i < 4; ++i) {
     const bool front = i < 2;
-    const double c = front ? cd : 1.0;
-    const double sn = front ? sd : 0.0;
-    // the contact point's velocity, body frame then wheel frame; sideways,
-    // the axle centre's (the single-track model: in effect Ackermann steering,
-    // the two wheels of an axle share its slip angle)
+    c[i] = front ? cd : 1.0;
+    sn[i] = front ? sd : 0.0;
     const double vbx = s.vx - s.r * m.y[i];
     const double vby = s.vy + s.r * m.x[i];
-    const double vcx = c * vbx + sn * vby;
-    const double vcy = c * vby - sn * s.vx;
-    const double fz = std::max(0.0, m.fz_static[i] + m.aero_share[i] * f_down + (front ? -transfer : transfer));
-    const double v_slip = s.w[i] * m.radius - vcx;
-    const TyreForce f = contact_force(m, s, i, fz, vcx, v_slip, vcy);
+    vcx[i] = c[i] * vbx + sn[i] * vby;
+    vcy[i] = c[i] * vby - sn[i] * s.vx;
+    fz[i] = std::max(0.0, m.fz_static[i] + m.aero_share[i] * f_down + (front ? -transfer : transfer));
+    v_slip[i] = s.w[i] * m.radius - vcx[i];
+  }
+
+  // the tyres' forces (wheel frame): the deflections' force, and below
+  // kLowSpeed the damper on the slip velocities. The damper adds to the
+  // spring up to the friction the wheel has: it still opposes the slip
+  // (dissipates), never beyond what the road takes
+  alignas(32) double fx[4], fy[4];
+  {
+    const D4 load = simd::load(fz);
+    D4 fx4, fy4, mu;
+    tyre_lanes(p, simd::load(s.ux.data()) * m.inv_sigma_x, simd::atan(simd::load(s.uy.data()) * m.inv_sigma_y), load,
+               fx4, fy4, mu);
+    const D4 vx4 = simd::load(vcx);
+    const D4 low = 1.0 - simd::abs(vx4) * (1.0 / kLowSpeed);
+    const D4 k = low * min_lanes(simd::splat(1.0), load * simd::load(m.inv_fz_static.data()));
+    const D4 fx_damped = clamp_lanes(fx4 + k * simd::load(m.c_x.data()) * simd::load(v_slip), -p.tyre_dx * mu,
+                                     p.tyre_dx * mu);
+    const D4 fy_damped = clamp_lanes(fy4 - k * simd::load(m.c_y.data()) * simd::load(vcy), -p.tyre_d * mu,
+                                     p.tyre_d * mu);
+    const auto slow = low > 0.0;
+    simd::store(fx, simd::select(slow, fx_damped, fx4));
+    simd::store(fy, simd::select(slow, fy_damped, fy4));
+  }
+
+  double fx_sum = 0.0, fy_sum = 0.0, mz = 0.0;
+  for (std::size_t i = 0; i < 4; ++i) {
     // the deflections relax towards the slips
-    d.ux[i] = v_slip - std::abs(vcx) * s.ux[i] * m.inv_sigma_x;
-    d.uy[i] = vcy - std::abs(vcx) * s.uy[i] * m.inv_sigma_y;
+    d.ux[i] = v_slip[i] - std::abs(vcx[i]) * s.ux[i] * m.inv_sigma_x;
+    d.uy[i] = vcy[i] - std::abs(vcx[i]) * s.uy[i] * m.inv_sigma_y;
     // the wheel's spin
-    out.t_net[i] = t_drive[i] - f.fx * m.radius;
+    out.t_net[i] = t_drive[i] - fx[i] * m.radius;
     out.t_fric[i] = s.brk * m.brake_torque[i] - regen[i] + m.rr_torque;
     d.w[i] = m.friction_sign[i] == 0.0 ? 0.0
                                        : (out.t_net[i] - m.friction_sign[i] * out.t_fric[i]) * m.inv_inertia[i];
@@ -306,11 +340,11 @@ Deriv derivative(const Model& m, const X& s) {
     // contact point, the lateral part at the axle centre (where its slip was
     // taken, so that each part's power is the force times its slip velocity
     // and the energy argument above holds)
-    const double fbx = c * f.fx - sn * f.fy;
-    const double fby = sn * f.fx + c * f.fy;
+    const double fbx = c[i] * fx[i] - sn[i] * fy[i];
+    const double fby = sn[i] * fx[i] + c[i] * fy[i];
     fx_sum += fbx;
     fy_sum += fby;
-    mz += m.x[i] * fby - m.y[i] * c * f.fx;
+    mz += m.x[i] * fby - m.y[i] * c[i] * fx[i];
   }
 
   d.vx = s.r * s.vy + (fx_sum - f_drag) * m.inv_m;
@@ -323,12 +357,30 @@ Deriv derivative(const Model& m, const X& s) {
   d.ax_load = (out.ax - s.ax_load) * m.inv_tau_pitch;
 
   // pose: rotate the body velocity into the map
-  const double cy = std::cos(s.yaw);
-  const double sy = std::sin(s.yaw);
+  const double sy = sines[1], cy = cosines[1];
   d.px = s.vx * cy - s.vy * sy;
   d.py = s.vx * sy + s.vy * cy;
   d.yaw = s.r;
   return out;
+}
+
+// the derivative for the CPU at hand: the AVX2 build (one register for the
+// four lanes) where the CPU has AVX2, else baseline x86-64's (two SSE2
+// registers). Both are elementwise IEEE arithmetic without FMA, so they give
+// the same bits (VehicleModel.TheAvx2AndBaselineStepsAgreeBitForBit)
+Deriv derivative_baseline(const Model& m, const X& s) { return derivative_body(m, s); }
+#if defined(__x86_64__)
+__attribute__((target("avx2"))) Deriv derivative_avx2(const Model& m, const X& s) { return derivative_body(m, s); }
+#endif
+
+using DerivativeFn = Deriv (*)(const Model&, const X&);
+
+DerivativeFn best_derivative() {
+#if defined(__x86_64__)
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx2")) return derivative_avx2;
+#endif
+  return derivative_baseline;
 }
 
 // a command replaced by a safe value when it is not finite (NaN from a broken
@@ -511,7 +563,9 @@ void decide_friction(Model& m, const X& x0, Deriv& k1) {
 
 }  // namespace
 
-void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
+namespace {
+
+void step_with(DerivativeFn derivative, const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
   assert(dt > 0.0);
 
   // commands: non-finite ones replaced by safe values, then limited
@@ -577,6 +631,17 @@ void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double
   s.ay = (k1.ay + 2.0 * (k2.ay + k3.ay) + k4.ay) / 6.0;
   s.yaw_accel = k.r / 6.0;
   s.power = (k1.power + 2.0 * (k2.power + k3.power) + k4.power) / 6.0;
+}
+
+}  // namespace
+
+void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
+  static const DerivativeFn derivative = best_derivative();
+  step_with(derivative, p, s, in, dt);
+}
+
+void step_baseline(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
+  step_with(derivative_baseline, p, s, in, dt);
 }
 
 // ---------------------------------------------------------------------------

@@ -207,6 +207,9 @@ VehicleState rolling_state(const VehicleParams& p, Pose2 base_pose, double speed
 
 // one fixed step of length dt (s): RK4 over the whole state (rigid body and actuators)
 void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt);
+// the same step as built for baseline x86-64 (step() takes the AVX2 build
+// where the CPU has AVX2): the tests hold the two to the same bits
+void step_baseline(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt);
 
 // the peak-friction factor of a wheel load fz (N): 1 + s (fz / Fz0 - 1), at least 0
 double load_factor(const VehicleParams& p, double fz);

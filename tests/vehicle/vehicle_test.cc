@@ -876,6 +876,32 @@ TEST(Determinism, TwoIdenticalRunsAreBitIdentical) {
   EXPECT_NE(a.x, 1.0);  // it did drive
 }
 
+// the step as built for AVX2 (where this CPU has it) and as built for
+// baseline x86-64: the same bits through launch, traction control, a slide,
+// lock-up under braking and rest (simd_math.h: elementwise, no FMA)
+TEST(Determinism, TheAvx2AndBaselineStepsAgreeBitForBit) {
+#if defined(__x86_64__)
+  __builtin_cpu_init();
+  if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 on this CPU: step() is step_baseline()";
+#endif
+  VehicleParams p = defaults();
+  p.steering_dead_time = 0.02;
+  VehicleState a = initial_state(p, Pose2{1.0, 2.0, 0.3});
+  VehicleState b = a;
+  for (int k = 0; k < 20000; ++k) {
+    const double t = k * kDt;
+    DriverInput in;
+    in.steering_angle = 0.35 * std::sin(1.7 * t);
+    in.throttle = t < 10.0 ? 1.0 : 0.0;
+    in.brake = t < 10.0 ? 0.0 : 1.0;
+    step(p, a, in, kDt);
+    step_baseline(p, b, in, kDt);
+  }
+  expect_states_equal(a, b);
+  EXPECT_GT(std::hypot(a.x - 1.0, a.y - 2.0), 50.0);  // it did drive
+  EXPECT_LT(speed(a), 0.01);                        // and stopped
+}
+
 // ---------------------------------------------------------------------------
 // accessors
 // ---------------------------------------------------------------------------
