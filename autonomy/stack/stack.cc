@@ -58,7 +58,7 @@ Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<percep
   auto result = planning::build_reference(spec_.oracle_path, spec_.oracle_closed, params_.planning.reference,
                                           std::nullopt, v_end);
   if (result.ok()) {
-    trajectory_ = std::move(result.trajectory);
+    set_trajectory(std::move(result.trajectory));
   } else {
     telemetry_.last_fault = "planning: " + result.reason;
   }
@@ -248,7 +248,7 @@ void Stack::plan(const hal::StateEstimate& st) {
       telemetry_.last_fault = "skidpad: " + sp.reason;
       return;
     }
-    trajectory_ = std::move(sp.trajectory);
+    set_trajectory(std::move(sp.trajectory));
     telemetry_.lap_locked = true;
     return;
   }
@@ -299,10 +299,10 @@ void Stack::plan(const hal::StateEstimate& st) {
     } else {
       // the search closes the loop from the car before the car is back at its
       // start: the path is good ahead, so drive it, and keep planning
-      trajectory_ = res.trajectory;
+      set_trajectory(res.trajectory);
     }
   } else {
-    trajectory_ = res.trajectory;
+    set_trajectory(res.trajectory);
   }
   last_plan_ = std::move(res);
   last_plan_cones_ = cones;
@@ -347,17 +347,37 @@ void Stack::catch_up(const hal::StateEstimate& st) {
   catch_up_until_ = driven_ + ramp;
 }
 
+void Stack::set_trajectory(Trajectory t) {
+  trajectory_ = std::move(t);
+  ++trajectory_version_;
+}
+
 double Stack::finish_approach_cap(Vec2 base) const {
   const MissionParams& mp = params_.mission;
   constexpr double kInf = std::numeric_limits<double>::infinity();
   if (spec_.finish_crossings <= 0 || telemetry_.finish_crossings != spec_.finish_crossings - 1 || trajectory_.empty())
     return kInf;
+  // the gates' places on the path: projected once per trajectory and gate
+  // list (every control cycle of the last lap asked for them again)
+  const auto same = [](const Segment& x, const Segment& y) {
+    return x.a.x == y.a.x && x.a.y == y.a.y && x.b.x == y.b.x && x.b.y == y.b.y;
+  };
+  if (!gates_projected_valid_ || gates_projected_version_ != trajectory_version_ ||
+      !std::equal(gates_.begin(), gates_.end(), gates_projected_.begin(), gates_projected_.end(), same)) {
+    gates_on_path_.clear();
+    for (const Segment& g : gates_) {
+      const TrajectoryProjection gate = project(trajectory_, 0.5 * (g.a + g.b), 0.0, 0.0);
+      gates_on_path_.push_back({gate.s, gate.offset});
+    }
+    gates_projected_ = gates_;
+    gates_projected_version_ = trajectory_version_;
+    gates_projected_valid_ = true;
+  }
   // braking at stop_decel_max (less in turns) to the finish speed that stops
   // in stop_distance
   const TrajectoryProjection car = project(trajectory_, base, 0.0, 0.0);
   double cap = kInf;
-  for (const Segment& g : gates_) {
-    const TrajectoryProjection gate = project(trajectory_, 0.5 * (g.a + g.b), 0.0, 0.0);
+  for (const GateOnPath& gate : gates_on_path_) {
     if (std::abs(gate.offset) > mp.gate_max_offset) continue;  // not a gate on this path
     double ahead = gate.s - car.s;
     if (trajectory_.closed && ahead < 0.0) ahead += trajectory_.length;
@@ -603,7 +623,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
     const TrajectoryProjection on = project(pending_lap_, front, 0.0, 0.0);
     if (std::abs(on.offset) < params_.mission.lap_switch_offset &&
         std::abs(wrap_angle(on.ref.heading - st.pose.yaw)) < params_.mission.lap_switch_heading) {
-      trajectory_ = std::move(pending_lap_);
+      set_trajectory(std::move(pending_lap_));
       pending_lap_ = Trajectory{};
       catch_up(st);
     }

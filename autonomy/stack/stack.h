@@ -291,9 +291,22 @@ class Stack {
   // (0 when there is no fresh estimate or trajectory)
   double emergency_steering(TimeNs now, double dt);
 
+  // the trajectory driven from now on (every assignment goes through here)
+  void set_trajectory(Trajectory t);
+
   StackParams params_;
   MissionSpec spec_;
   Trajectory trajectory_;
+  std::uint64_t trajectory_version_ = 0;  // counts set_trajectory()
+  // finish_approach_cap's gates on trajectory_ (arc length, offset), kept
+  // for the trajectory version and the gates they were projected for
+  struct GateOnPath {
+    double s = 0.0, offset = 0.0;
+  };
+  mutable std::vector<GateOnPath> gates_on_path_;
+  mutable std::vector<Segment> gates_projected_;
+  mutable std::uint64_t gates_projected_version_ = 0;
+  mutable bool gates_projected_valid_ = false;
   control::Controller controller_;
   Telemetry telemetry_;
   Profile* profile_ = nullptr;
