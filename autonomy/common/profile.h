@@ -6,8 +6,9 @@
 // Nothing is timed through a null Profile pointer (StageScope).
 //
 // The clock: the CPU's time-stamp counter (x86-64; 10 ns a read here
-// against steady_clock's 24: the loop enters ~4 stages a physics step, a
-// tenth of a run on the true state), its rate measured against
+// against steady_clock's 24: the loop enters 3 stages a physics step,
+// physics, scoring and logging, and the reads were a tenth of a run on the
+// true state when it entered 6), its rate measured against
 // steady_clock between start() and stop(), so the stages add up to
 // steady_clock's time exactly (the counter runs at a constant rate on
 // CPUs that say constant_tsc, every x86-64 of the last decade); elsewhere,

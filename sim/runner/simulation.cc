@@ -298,8 +298,10 @@ SimState::SimState(const SimModel& model, WireTap* tap)
   run_due(model, *this);
 }
 
-void step(const SimModel& model, SimState& s) {
-  // physics: the car, the cones it may hit, the timing gates
+namespace {
+
+// the physics of one step; false when the state diverged (the run ends)
+bool physics_step(const SimModel& model, SimState& s) {
   const StageScope physics(&s.profile, Stage::Physics);
   const vehicle::VehicleParams& car = model.scenario.vehicle;
   const double nose_x = model.footprint.x_max;
@@ -323,7 +325,7 @@ void step(const SimModel& model, SimState& s) {
     s.event.abort(s.t, why);
     s.done = true;
     s.controlled = s.sampled = false;
-    return;
+    return false;
   }
   const Pose2 base = vehicle::base_pose(car, s.car);
   const Vec2 v_world = rotate(vehicle::base_velocity(car, s.car), base.yaw);
@@ -336,9 +338,17 @@ void step(const SimModel& model, SimState& s) {
   s.now = s.k * model.dt_ns;
   s.t = static_cast<double>(s.k) * model.dt;
   s.event.on_motion(t0, nose0, t0 + model.dt, base.transform({nose_x, 0.0}));
-  const StageScope outside(&s.profile, Stage::Other);  // what falls due times itself
-  run_due(model, s);
+  return true;
 }
+
+}  // namespace
+
+void step(const SimModel& model, SimState& s) {
+  // physics: the car, the cones it may hit, the timing gates; then what
+  // falls due, outside every stage (each stage in it times itself)
+  if (physics_step(model, s)) run_due(model, s);
+}
+
 
 RunResult run(const Scenario& scenario, const world::TrackModel& track, const std::vector<Observer*>& extra,
               WireTap* tap) {
@@ -364,13 +374,17 @@ RunResult run(const Scenario& scenario, const world::TrackModel& track, const st
   PerceptionScorer scorer;
   SlamScorer slam;
   SnapshotRecorder snapshot;
-  Observer* const observers[] = {&snapshot, &scorer, &slam, &log};
+  Observer* const scorers[] = {&snapshot, &scorer, &slam};
   const PageFaults faults0 = page_faults_now();
   state.profile.start();
   for (;;) {
-    for (Observer* o : observers) {
-      const StageScope scope(&state.profile, o == &log ? Stage::Logging : Stage::Scoring);
-      o->observe(model, state);
+    {
+      const StageScope scope(&state.profile, Stage::Scoring);
+      for (Observer* o : scorers) o->observe(model, state);
+    }
+    {
+      const StageScope scope(&state.profile, Stage::Logging);
+      log.observe(model, state);
     }
     for (Observer* o : extra) {
       const StageScope scope(&state.profile, Stage::Logging);  // the caller's: a run's MCAP log
