@@ -38,13 +38,16 @@ constexpr double kPio2 = 0.5 * kPi;   // pi/2, rounded (exactly half of kPi)
 constexpr double kPio4 = 0.25 * kPi;  // pi/4, rounded
 constexpr double kMoreBits = 6.123233995736765886130e-17;  // pi/2 - kPio2
 
-// x + x z P(z)/Q(z), z = x^2: atan(x) for |x| <= 0.66
-inline double atan_kernel(double x) {
-  const double z = x * x;
-  const double p = (((-8.750608600031904122785e-1 * z - 1.615753718733365076637e1) * z - 7.500855792314704667340e1) * z -
-                    1.228866684490136173410e2) * z - 6.485021904942025371773e1;
-  const double q = ((((z + 2.485846490142306297962e1) * z + 1.650270098316988542046e2) * z + 4.328810604912902668951e2) * z +
-                    4.853903996359136964868e2) * z + 1.945506571482613964425e2;
+// x + x z P(z)/Q(z), z = x^2: atan(x) for |x| <= 0.66; T a double, or four
+// (simd_math.h: the same operations lane by lane; always inlined, so that an
+// AVX2 build of the caller keeps it in one register)
+template <class T>
+__attribute__((always_inline)) inline T atan_kernel(T x) {
+  const T z = x * x;
+  const T p = (((-8.750608600031904122785e-1 * z - 1.615753718733365076637e1) * z - 7.500855792314704667340e1) * z -
+               1.228866684490136173410e2) * z - 6.485021904942025371773e1;
+  const T q = ((((z + 2.485846490142306297962e1) * z + 1.650270098316988542046e2) * z + 4.328810604912902668951e2) * z +
+               4.853903996359136964868e2) * z + 1.945506571482613964425e2;
   return x * (z * p / q) + x;
 }
 

@@ -13,7 +13,7 @@
 // baseline x86-64 (sim/vehicle/vehicle.cc), computes the same result.
 //
 // atan: Cephes' (S. L. Moshier, "Methods and Programs for Mathematical
-// Functions", 1989), as fast_math.h's atan2: x + x z P(z)/Q(z), z = x^2, on
+// Functions", 1989), fast_math.h's kernel: x + x z P(z)/Q(z), z = x^2, on
 // [0, 0.66], with (0.66, tan(3 pi/8)] folded by pi/4 + atan((x - 1)/(x + 1))
 // and the rest by pi/2 + atan(-1/x); the three cases selected lane by lane,
 // not branched on. sin and cos: the argument reduced by the nearest multiple
@@ -26,6 +26,8 @@
 // atan(+-inf) = +-pi/2.
 #include <cstdint>
 #include <cstring>
+
+#include "autonomy/common/fast_math.h"
 
 namespace paddock::simd {
 
@@ -79,16 +81,6 @@ constexpr double kPio2Lo = 2.02226624879595063154e-21;
 constexpr double kTwoOverPi = 6.36619772367581382433e-01;
 constexpr double kRoundMagic = 6755399441055744.0;  // 1.5 * 2^52: x + it - it rounds x to an integer
 
-// x + x z P(z)/Q(z), z = x^2: atan(x) for |x| <= 0.66
-PADDOCK_SIMD_INLINE D4 atan_kernel(D4 x) {
-  const D4 z = x * x;
-  const D4 p = (((-8.750608600031904122785e-1 * z - 1.615753718733365076637e1) * z - 7.500855792314704667340e1) * z -
-                1.228866684490136173410e2) * z - 6.485021904942025371773e1;
-  const D4 q = ((((z + 2.485846490142306297962e1) * z + 1.650270098316988542046e2) * z + 4.328810604912902668951e2) * z +
-                4.853903996359136964868e2) * z + 1.945506571482613964425e2;
-  return x * (z * p / q) + x;
-}
-
 // fdlibm's __kernel_sin and __kernel_cos (with no tail) on [-pi/4, pi/4]
 PADDOCK_SIMD_INLINE D4 sin_kernel(D4 x) {
   const D4 z = x * x;
@@ -124,7 +116,7 @@ PADDOCK_SIMD_INLINE D4 atan(D4 x) {
   const D4 den = select(big, a, select(mid, a + 1.0, splat(1.0)));
   const D4 base = select(big, splat(kPio2), select(mid, splat(kPio4), splat(0.0)));
   const D4 extra = select(big, splat(kMoreBits), select(mid, splat(0.5 * kMoreBits), splat(0.0)));
-  const D4 r = base + (atan_kernel(num / den) + extra);
+  const D4 r = base + (fast_math_detail::atan_kernel(num / den) + extra);
   return copysign(r, x);
 }
 
