@@ -143,9 +143,8 @@ void sample(const SimModel& model, SimState& s, const Pose2& base) {
 
 // what falls due at the state's instant, in the order a car meets it: the
 // sensors' measurements, the control cycle, the event's sample
-void run_due(const SimModel& model, SimState& s) {
+void run_due(const SimModel& model, SimState& s, const Pose2& base) {
   s.hal.set_now(s.now);
-  const Pose2 base = vehicle::base_pose(model.scenario.vehicle, s.car);
   if (!model.raw_perception && s.k % model.every.cone_sensor == 0) measure_cones(s, base);
   // a LiDAR rotation that ends now, cast from the poses it was taken at
   s.true_poses.record(s.now, base);
@@ -295,13 +294,14 @@ SimState::SimState(const SimModel& model, WireTap* tap)
   stack.set_profile(&profile);
   if (raw) raw->set_profile(&profile);
   faults.place(model.track, model.cones);
-  run_due(model, *this);
+  run_due(model, *this, vehicle::base_pose(model.scenario.vehicle, car));
 }
 
 namespace {
 
-// the physics of one step; false when the state diverged (the run ends)
-bool physics_step(const SimModel& model, SimState& s) {
+// the physics of one step: the car's base pose after it, or none when the
+// state diverged (the run ends)
+std::optional<Pose2> physics_step(const SimModel& model, SimState& s) {
   const StageScope physics(&s.profile, Stage::Physics);
   const vehicle::VehicleParams& car = model.scenario.vehicle;
   const double nose_x = model.footprint.x_max;
@@ -325,7 +325,7 @@ bool physics_step(const SimModel& model, SimState& s) {
     s.event.abort(s.t, why);
     s.done = true;
     s.controlled = s.sampled = false;
-    return false;
+    return std::nullopt;
   }
   const Pose2 base = vehicle::base_pose(car, s.car);
   const Vec2 v_world = rotate(vehicle::base_velocity(car, s.car), base.yaw);
@@ -338,7 +338,7 @@ bool physics_step(const SimModel& model, SimState& s) {
   s.now = s.k * model.dt_ns;
   s.t = static_cast<double>(s.k) * model.dt;
   s.event.on_motion(t0, nose0, t0 + model.dt, base.transform({nose_x, 0.0}));
-  return true;
+  return base;
 }
 
 }  // namespace
@@ -346,7 +346,7 @@ bool physics_step(const SimModel& model, SimState& s) {
 void step(const SimModel& model, SimState& s) {
   // physics: the car, the cones it may hit, the timing gates; then what
   // falls due, outside every stage (each stage in it times itself)
-  if (physics_step(model, s)) run_due(model, s);
+  if (const std::optional<Pose2> base = physics_step(model, s)) run_due(model, s, *base);
 }
 
 
