@@ -69,6 +69,7 @@ bool segments_cross(Vec2 a, Vec2 b, Vec2 c, Vec2 d) {
 
 void path_boundaries(const std::vector<Vec2>& path, bool closed, const std::vector<Cone>& cones,
                      const Triangulation& tri, std::vector<Vec2>& left, std::vector<Vec2>& right) {
+  if (path.size() < 2) return;  // no path, nothing it passes
   std::vector<Projection> on(cones.size());
   std::vector<char> taken(cones.size(), 0);
   for (std::size_t i = 0; i < cones.size(); ++i) {
@@ -81,7 +82,9 @@ void path_boundaries(const std::vector<Vec2>& path, bool closed, const std::vect
   // a candidate, crossed if one of the path's segments crosses it
   const std::size_t n = path.size(), segments = closed ? n : n - 1;
   for (const TriEdge& e : tri.edges) {
-    if (e.a >= cones.size() || e.b >= cones.size() || (taken[e.a] && taken[e.b])) continue;
+    if (e.a >= cones.size() || e.b >= cones.size() || e.a >= tri.representative.size() ||
+        e.b >= tri.representative.size() || (taken[e.a] && taken[e.b]))
+      continue;
     if (tri.representative[e.a] != e.a || tri.representative[e.b] != e.b) continue;
     if ((on[e.a].signed_offset > 0.0) == (on[e.b].signed_offset > 0.0)) continue;
     const Vec2 a = cones[e.a].position, b = cones[e.b].position;

@@ -367,7 +367,7 @@ PADDOCK_SIMD_INLINE Deriv derivative_body(const Model& m, const X& s) {
 // the derivative for the CPU at hand: the AVX2 build (one register for the
 // four lanes) where the CPU has AVX2, else baseline x86-64's (two SSE2
 // registers). Both are elementwise IEEE arithmetic without FMA, so they give
-// the same bits (VehicleModel.TheAvx2AndBaselineStepsAgreeBitForBit)
+// the same bits (Determinism.TheAvx2AndBaselineStepsAgreeBitForBit)
 Deriv derivative_baseline(const Model& m, const X& s) { return derivative_body(m, s); }
 #if defined(__x86_64__)
 __attribute__((target("avx2"))) Deriv derivative_avx2(const Model& m, const X& s) { return derivative_body(m, s); }
