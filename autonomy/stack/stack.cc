@@ -359,10 +359,8 @@ double Stack::finish_approach_cap(Vec2 base) const {
     return kInf;
   // the gates' places on the path: projected once per trajectory and gate
   // list (every control cycle of the last lap asked for them again)
-  const auto same = [](const Segment& x, const Segment& y) {
-    return x.a.x == y.a.x && x.a.y == y.a.y && x.b.x == y.b.x && x.b.y == y.b.y;
-  };
-  if (!gates_projected_valid_ || gates_projected_version_ != trajectory_version_ ||
+  const auto same = [](const Segment& x, const Segment& y) { return x.a == y.a && x.b == y.b; };
+  if (gates_projected_version_ != trajectory_version_ ||
       !std::equal(gates_.begin(), gates_.end(), gates_projected_.begin(), gates_projected_.end(), same)) {
     gates_on_path_.clear();
     for (const Segment& g : gates_) {
@@ -371,7 +369,6 @@ double Stack::finish_approach_cap(Vec2 base) const {
     }
     gates_projected_ = gates_;
     gates_projected_version_ = trajectory_version_;
-    gates_projected_valid_ = true;
   }
   // braking at stop_decel_max (less in turns) to the finish speed that stops
   // in stop_distance

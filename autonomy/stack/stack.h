@@ -299,14 +299,14 @@ class Stack {
   Trajectory trajectory_;
   std::uint64_t trajectory_version_ = 0;  // counts set_trajectory()
   // finish_approach_cap's gates on trajectory_ (arc length, offset), kept
-  // for the trajectory version and the gates they were projected for
+  // for the trajectory version and the gates they were projected for (at
+  // first none, for version 0: no trajectory, nothing asked)
   struct GateOnPath {
     double s = 0.0, offset = 0.0;
   };
   mutable std::vector<GateOnPath> gates_on_path_;
   mutable std::vector<Segment> gates_projected_;
   mutable std::uint64_t gates_projected_version_ = 0;
-  mutable bool gates_projected_valid_ = false;
   control::Controller controller_;
   Telemetry telemetry_;
   Profile* profile_ = nullptr;

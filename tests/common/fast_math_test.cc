@@ -10,16 +10,14 @@
 #include <limits>
 #include <random>
 
+#include "tests/common/ulps.h"
+
 namespace paddock {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// |a - b| in units of b's last place (the spacing of doubles at b)
-double ulps(double a, double b) {
-  const double spacing = std::nextafter(std::abs(b), kInf) - std::abs(b);
-  return std::abs(a - b) / spacing;
-}
+using testing::ulps;
 
 // a magnitude from 1e-20 to 1e20, log-uniform, either sign
 double spread(std::mt19937_64& rng) {

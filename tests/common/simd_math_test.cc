@@ -14,16 +14,14 @@
 #include <random>
 #include <vector>
 
+#include "tests/common/ulps.h"
+
 namespace paddock {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// |a - b| in units of b's last place
-double ulps(double a, double b) {
-  const double spacing = std::nextafter(std::abs(b), kInf) - std::abs(b);
-  return std::abs(a - b) / spacing;
-}
+using testing::ulps;
 
 struct Lanes {
   double atan[4], sin[4], cos[4];
