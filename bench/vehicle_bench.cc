@@ -21,6 +21,7 @@ VehicleParams bench_params() {
 
 void BM_VehicleStepCornering(benchmark::State& st) {
   const VehicleParams p = bench_params();
+  const Car car(p);
   constexpr double dt = 1e-3;
   VehicleState s = rolling_state(p, Pose2{}, 12.0);
   // a steady left-hand corner at 12 m/s (steering 0.11 rad: radius ~14 m, ~1 g), the
@@ -28,9 +29,9 @@ void BM_VehicleStepCornering(benchmark::State& st) {
   auto input = [&]() {
     return DriverInput{0.11, std::fmin(std::fmax(0.1 + 0.5 * (12.0 - s.vx), 0.0), 1.0), 0.0};
   };
-  for (int k = 0; k < 3000; ++k) step(p, s, input(), dt);
+  for (int k = 0; k < 3000; ++k) step(car, s, input(), dt);
   for (auto _ : st) {
-    step(p, s, input(), dt);
+    step(car, s, input(), dt);
     benchmark::DoNotOptimize(s);
     benchmark::ClobberMemory();
   }

@@ -37,8 +37,7 @@ std::vector<Vec2> skidpad_path(const world::SkidpadGeometry& g) {
 }  // namespace
 
 SimModel compile_model(const Scenario& scenario, const world::TrackModel& track) {
-  SimModel m;
-  m.scenario = scenario;
+  SimModel m(scenario);
   m.track = track;
   m.cones = event_cones(track);
   m.blocks = world::venue_blocks(track, m.cones, scenario.venue);

@@ -31,7 +31,10 @@ struct StepPeriods {
 };
 
 struct SimModel {
+  explicit SimModel(const Scenario& sc) : scenario(sc), car(sc.vehicle) {}
+
   Scenario scenario;           // as loaded: every module's and sensor's parameters
+  vehicle::Car car;            // its vehicle, compiled for stepping
   world::TrackModel track;     // the event's track (the event's on-track test points into it)
   std::vector<Cone> cones;     // the cones standing at the event (event_cones)
   std::vector<world::Block> blocks;  // the venue's barrier blocks ([venue]; the sensors see them)

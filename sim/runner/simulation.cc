@@ -309,11 +309,12 @@ std::optional<Pose2> physics_step(const SimModel& model, SimState& s) {
   // in the rain ([faults.rain]) the tyres grip less
   const double grip = s.faults.grip(s.t);
   if (grip < 1.0 && !s.wet) {
-    s.wet = car;
-    s.wet->tyre_d *= grip;
-    s.wet->tyre_dx *= grip;
+    vehicle::VehicleParams wet = car;
+    wet.tyre_d *= grip;
+    wet.tyre_dx *= grip;
+    s.wet.emplace(wet);
   }
-  vehicle::step(grip < 1.0 ? *s.wet : car, s.car, s.input, model.dt);
+  vehicle::step(grip < 1.0 ? *s.wet : model.car, s.car, s.input, model.dt);
   if (!vehicle::is_finite(s.car)) {
     // a state that is no number cannot be stepped, sensed or timed: the run
     // ends here, with its reason; nothing falls due at this instant

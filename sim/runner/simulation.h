@@ -92,7 +92,7 @@ struct SimState {
   bool go_sent = false;
   EbsStop ebs;
   FaultInjector faults;  // [faults] at work
-  std::optional<vehicle::VehicleParams> wet;  // the car in the rain ([faults.rain]), once it rains
+  std::optional<vehicle::Car> wet;  // the car in the rain ([faults.rain]), once it rains
   int control_cycles = 0;
   // what the current instant ran
   bool controlled = false;  // a control cycle

@@ -42,7 +42,9 @@ std::vector<double> brake_pedals() {
 // (its gains' share of those tuned for a car answering its steering in
 // 60 ms), and the time simulated so far
 struct TestCar {
+  explicit TestCar(const VehicleParams& params) : p(params), compiled(params) {}
   const VehicleParams& p;
+  vehicle::Car compiled;
   double driver_scale = 1.0;
   double simulated = 0.0;  // s
 };
@@ -60,7 +62,7 @@ class Drive {
   // one step; a state that is no longer finite is an error (the step is too long for this car)
   void step(const DriverInput& in) {
     const double x = s_.x, y = s_.y;
-    vehicle::step(car_.p, s_, in, kDt);
+    vehicle::step(car_.compiled, s_, in, kDt);
     if (!vehicle::is_finite(s_)) {
       throw UserError("the vehicle model diverged " + fixed(t(), 3) +
                       " s into an experiment (its state is no longer finite)");
@@ -384,7 +386,7 @@ std::vector<GgvRow> ggv_rows(TestCar& car, double top_speed) {
 VehicleReport vehicle_report(const VehicleParams& p, const std::string& source) {
   VehicleReport r;
   r.source = source;
-  TestCar car{p};
+  TestCar car(p);
   r.acceleration = full_throttle_from_rest(car);
   std::tie(r.full_brake, r.best_brake) = stops_from(car, kBrakingSpeed);
   car.driver_scale = driver_scale(car);
@@ -396,7 +398,7 @@ VehicleReport vehicle_report(const VehicleParams& p, const std::string& source) 
 
 GgvMeasurement measure_ggv(const VehicleParams& p) {
   GgvMeasurement m;
-  TestCar car{p};
+  TestCar car(p);
   const AccelerationRun a = full_throttle_from_rest(car);
   m.top_speed = a.top_speed;
   car.driver_scale = driver_scale(car);

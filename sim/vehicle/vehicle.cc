@@ -194,9 +194,10 @@ struct Deriv {
   std::array<double, 4> t_fric;  // N m, the friction torque available (brake + rolling resistance)
 };
 
-// everything constant over one step
-struct Model {
-  const VehicleParams* p;
+}  // namespace
+
+// what a car's parameters imply for every step (Car): computed once
+struct CarConstants {
   double inv_m, inv_iz;
   double transfer_per_wheel;  // N per m/s^2: m h_cg / L / 2
   std::array<double, 4> x, y;  // contact points from the CG, m
@@ -206,13 +207,22 @@ struct Model {
   std::array<double, 4> brake_torque;  // N m at full brake
   std::array<double, 4> regen_torque;  // N m available at the wheel
   std::array<double, 4> c_x, c_y;      // N s/m, low-speed damping at the static load
-  std::array<double, 4> tv_torque;     // N m, torque vectoring shift
-  std::array<double, 4> traction;      // traction control's torque factor, held over the step
-  std::array<double, 4> friction_sign;  // 0: held at rest; +-1: friction opposes that spin
   double rr_torque;                     // N m per wheel
   double radius;
   double t_wheel_max, p_wheel_max, w_max, inv_fade;
   double eta, inv_eta, inv_sigma_x, inv_sigma_y;
+  double ux_cap, uy_cap;  // m, the deflections at kSlipCap
+};
+
+namespace {
+
+// everything constant over one step: the car's constants, and what the step's
+// start decides
+struct Model : CarConstants {
+  const VehicleParams* p;
+  std::array<double, 4> tv_torque;     // N m, torque vectoring shift
+  std::array<double, 4> traction;      // traction control's torque factor, held over the step
+  std::array<double, 4> friction_sign;  // 0: held at rest; +-1: friction opposes that spin
   double inv_tau_steer, inv_tau_thr, inv_tau_brk, inv_tau_pitch;  // 1/s, 0 = instantaneous (set outside RK4)
   double steer_cmd, thr_cmd, brk_cmd;
 };
@@ -472,50 +482,70 @@ VehicleState rolling_state(const VehicleParams& p, Pose2 base_pose_in, double sp
 
 namespace {
 
+// the car's constants, as step() takes them
+CarConstants car_constants(const VehicleParams& p) {
+  CarConstants k;
+  k.inv_m = 1.0 / p.mass;
+  k.inv_iz = 1.0 / p.inertia_z;
+  k.transfer_per_wheel = 0.5 * p.mass * p.h_cg / (p.lf + p.lr);
+  k.radius = p.wheel_radius;
+  k.rr_torque = 0.25 * p.cr0 * p.wheel_radius;
+  k.t_wheel_max = p.motor_torque_max * p.gear_ratio;
+  k.p_wheel_max = drive_power_limit(p);
+  k.w_max = p.motor_speed_max / p.gear_ratio;
+  k.inv_fade = 1.0 / (kMotorFade * k.w_max);
+  k.eta = p.drivetrain_efficiency;
+  k.inv_eta = 1.0 / p.drivetrain_efficiency;
+  k.inv_sigma_x = 1.0 / p.relaxation_length_x;
+  k.inv_sigma_y = 1.0 / p.relaxation_length_y;
+  const std::array<Vec2, 4> off = wheel_offsets_cg(p);
+  for (std::size_t i = 0; i < 4; ++i) {
+    const bool front = i < 2;
+    const WheelStatics w = wheel_statics(p, i);
+    k.x[i] = off[i].x;
+    k.y[i] = off[i].y;
+    k.fz_static[i] = w.fz;
+    k.inv_fz_static[i] = 1.0 / w.fz;
+    k.aero_share[i] = 0.5 * (front ? p.aero_balance_front : 1.0 - p.aero_balance_front);
+    k.inv_inertia[i] = 1.0 / wheel_inertia_of(p, i);
+    k.drive_share[i] = drive_share(p, i);
+    k.brake_torque[i] = 0.5 * (front ? p.brake_split_front : 1.0 - p.brake_split_front) * p.brake_force_max * p.wheel_radius;
+    k.regen_torque[i] = k.drive_share[i] * p.regen_torque_max * p.gear_ratio;
+    k.c_x[i] = low_speed_damping(p, w.c_kappa, p.relaxation_length_x);
+    k.c_y[i] = low_speed_damping(p, w.c_alpha, p.relaxation_length_y);
+  }
+  // a sliding tyre's deflection stops growing at kSlipCap
+  k.ux_cap = kSlipCap / p.tyre_bx * p.relaxation_length_x;
+  k.uy_cap = std::tan(std::min(kSlipCap / p.tyre_b, 1.4)) * p.relaxation_length_y;
+  return k;
+}
+
+}  // namespace
+
+Car::Car(const VehicleParams& p) : p_(p), constants_(std::make_shared<const CarConstants>(car_constants(p))) {}
+
+namespace {
+
 // the model of one step: the car's constants, the commands, and what the VCU
 // (traction control, torque vectoring) decided from the state at its start
-Model make_model(const VehicleParams& p, const VehicleState& s, const DriverInput& in, double steer_cmd, double dt) {
+Model make_model(const Car& car, const VehicleState& s, const DriverInput& in, double steer_cmd, double dt) {
+  const VehicleParams& p = car.params();
   Model m;
+  static_cast<CarConstants&>(m) = car.constants();
   m.p = &p;
-  m.inv_m = 1.0 / p.mass;
-  m.inv_iz = 1.0 / p.inertia_z;
-  m.transfer_per_wheel = 0.5 * p.mass * p.h_cg / (p.lf + p.lr);
-  m.radius = p.wheel_radius;
-  m.rr_torque = 0.25 * p.cr0 * p.wheel_radius;
-  m.t_wheel_max = p.motor_torque_max * p.gear_ratio;
-  m.p_wheel_max = drive_power_limit(p);
-  m.w_max = p.motor_speed_max / p.gear_ratio;
-  m.inv_fade = 1.0 / (kMotorFade * m.w_max);
-  m.eta = p.drivetrain_efficiency;
-  m.inv_eta = 1.0 / p.drivetrain_efficiency;
-  m.inv_sigma_x = 1.0 / p.relaxation_length_x;
-  m.inv_sigma_y = 1.0 / p.relaxation_length_y;
-  const std::array<Vec2, 4> off = wheel_offsets_cg(p);
   const double yaw_moment = finite_or(in.yaw_moment, 0.0);
   const double sd = std::sin(s.steering), cd = std::cos(s.steering);
   for (std::size_t i = 0; i < 4; ++i) {
     const bool front = i < 2;
-    const WheelStatics w = wheel_statics(p, i);
-    m.x[i] = off[i].x;
-    m.y[i] = off[i].y;
-    m.fz_static[i] = w.fz;
-    m.inv_fz_static[i] = 1.0 / w.fz;
-    m.aero_share[i] = 0.5 * (front ? p.aero_balance_front : 1.0 - p.aero_balance_front);
-    m.inv_inertia[i] = 1.0 / wheel_inertia_of(p, i);
-    m.drive_share[i] = drive_share(p, i);
-    m.brake_torque[i] = 0.5 * (front ? p.brake_split_front : 1.0 - p.brake_split_front) * p.brake_force_max * p.wheel_radius;
-    m.regen_torque[i] = m.drive_share[i] * p.regen_torque_max * p.gear_ratio;
-    m.c_x[i] = low_speed_damping(p, w.c_kappa, p.relaxation_length_x);
-    m.c_y[i] = low_speed_damping(p, w.c_alpha, p.relaxation_length_y);
     // torque vectoring: the driven axles share the yaw moment as their drive
     // shares, each as a left/right force difference M / track: +-M r / track
     const double track = front ? p.track_front : p.track_rear;
-    m.tv_torque[i] = (off[i].y > 0.0 ? -1.0 : 1.0) * 2.0 * m.drive_share[i] * yaw_moment * p.wheel_radius / track;
+    m.tv_torque[i] = (m.y[i] > 0.0 ? -1.0 : 1.0) * 2.0 * m.drive_share[i] * yaw_moment * p.wheel_radius / track;
     // traction control: each driven wheel's torque is cut linearly from the
     // slip ratio kappa* to (1 + kTractionBand) kappa*, sampled at the step's start
     m.traction[i] = 1.0;
     if (p.traction_control_slip > 0.0 && m.drive_share[i] > 0.0) {
-      const double vbx = s.vx - s.r * off[i].y, vby = s.vy + s.r * off[i].x;
+      const double vbx = s.vx - s.r * m.y[i], vby = s.vy + s.r * m.x[i];
       const double vcx = front ? cd * vbx + sd * vby : vbx;
       const double kappa = (s.omega[i] * p.wheel_radius - vcx) / std::max(std::abs(vcx), kTractionSpeedFloor);
       const double excess = (kappa - p.traction_control_slip) / (kTractionBand * p.traction_control_slip);
@@ -565,13 +595,14 @@ void decide_friction(Model& m, const X& x0, Deriv& k1) {
 
 namespace {
 
-void step_with(DerivativeFn derivative, const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
+void step_with(DerivativeFn derivative, const Car& car, VehicleState& s, const DriverInput& in, double dt) {
   assert(dt > 0.0);
+  const VehicleParams& p = car.params();
 
   // commands: non-finite ones replaced by safe values, then limited
   const double steer_req = std::clamp(finite_or(in.steering_angle, s.steering), -p.steering_max, p.steering_max);
   const double steer_cmd = delayed_steering(p, s, steer_req, dt);
-  Model m = make_model(p, s, in, steer_cmd, dt);
+  Model m = make_model(car, s, in, steer_cmd, dt);
   if (m.brk_cmd >= kPlausibilityBrake && m.thr_cmd > kPlausibilityCut) s.torque_cut = true;
   if (m.thr_cmd < kPlausibilityReset) s.torque_cut = false;
   if (s.torque_cut) m.thr_cmd = 0.0;
@@ -618,12 +649,10 @@ void step_with(DerivativeFn derivative, const VehicleParams& p, VehicleState& s,
   s.energy = x1.energy;
   // friction stops a wheel, never turns it back; a sliding tyre's deflection
   // stops growing at kSlipCap
-  const double ux_cap = kSlipCap / p.tyre_bx * p.relaxation_length_x;
-  const double uy_cap = std::tan(std::min(kSlipCap / p.tyre_b, 1.4)) * p.relaxation_length_y;
   for (std::size_t i = 0; i < 4; ++i) {
     s.omega[i] = x1.w[i] * m.friction_sign[i] < 0.0 ? 0.0 : x1.w[i];
-    s.u_x[i] = std::clamp(x1.ux[i], -ux_cap, ux_cap);
-    s.u_y[i] = std::clamp(x1.uy[i], -uy_cap, uy_cap);
+    s.u_x[i] = std::clamp(x1.ux[i], -m.ux_cap, m.ux_cap);
+    s.u_y[i] = std::clamp(x1.uy[i], -m.uy_cap, m.uy_cap);
   }
 
   // mean accelerations and power over the step, with RK4's weights
@@ -635,13 +664,13 @@ void step_with(DerivativeFn derivative, const VehicleParams& p, VehicleState& s,
 
 }  // namespace
 
-void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
+void step(const Car& car, VehicleState& s, const DriverInput& in, double dt) {
   static const DerivativeFn derivative = best_derivative();
-  step_with(derivative, p, s, in, dt);
+  step_with(derivative, car, s, in, dt);
 }
 
-void step_baseline(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt) {
-  step_with(derivative_baseline, p, s, in, dt);
+void step_baseline(const Car& car, VehicleState& s, const DriverInput& in, double dt) {
+  step_with(derivative_baseline, car, s, in, dt);
 }
 
 // ---------------------------------------------------------------------------

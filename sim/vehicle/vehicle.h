@@ -11,12 +11,14 @@
 // load, lagged longitudinal load transfer, and lagged, rate-limited actuators
 // with an optional steering dead time complete it.
 //
-// MuJoCo style: a constant model (VehicleParams) + mutable state (VehicleState)
-// + a free function step(). Many vehicles can be simulated side by side; nothing
-// here allocates, reads files or keeps global mutable state.
+// MuJoCo style: a constant model (VehicleParams, compiled once into a Car) +
+// mutable state (VehicleState) + a free function step(). Many vehicles can be
+// simulated side by side; step() never allocates, and nothing here reads
+// files or keeps global mutable state.
 #include <array>
 #include <cstddef>
 #include <limits>
+#include <memory>
 
 #include "autonomy/common/geometry.h"
 #include "autonomy/common/params.h"
@@ -205,11 +207,27 @@ VehicleState initial_state(const VehicleParams& p, Pose2 base_pose);
 // base_pose: every wheel rolling at that speed, actuators at rest
 VehicleState rolling_state(const VehicleParams& p, Pose2 base_pose, double speed);
 
+// what a car's parameters imply for every step (vehicle.cc)
+struct CarConstants;
+
+// a car ready to be stepped: its parameters and what step() derives from them
+// once (as MuJoCo compiles its mjModel). A value: copies share the constant part
+class Car {
+ public:
+  explicit Car(const VehicleParams& p);
+  const VehicleParams& params() const { return p_; }
+  const CarConstants& constants() const { return *constants_; }
+
+ private:
+  VehicleParams p_;
+  std::shared_ptr<const CarConstants> constants_;
+};
+
 // one fixed step of length dt (s): RK4 over the whole state (rigid body and actuators)
-void step(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt);
+void step(const Car& car, VehicleState& s, const DriverInput& in, double dt);
 // the same step as built for baseline x86-64 (step() takes the AVX2 build
 // where the CPU has AVX2): the tests hold the two to the same bits
-void step_baseline(const VehicleParams& p, VehicleState& s, const DriverInput& in, double dt);
+void step_baseline(const Car& car, VehicleState& s, const DriverInput& in, double dt);
 
 // the peak-friction factor of a wheel load fz (N): 1 + s (fz / Fz0 - 1), at least 0
 double load_factor(const VehicleParams& p, double fz);

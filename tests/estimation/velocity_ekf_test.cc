@@ -59,6 +59,7 @@ using Profile = std::function<vehicle::DriverInput(double t)>;
 // seeded from `seed`, the estimator reset at the start's base pose
 DriveLog drive(const vehicle::VehicleParams& car, vehicle::VehicleState s, const Profile& profile, double duration,
           std::uint64_t seed, const VelocityEkfParams& ep = {}, const sensors::ImuParams& ip = {}, int stuck_wheel = -1) {
+  const vehicle::Car compiled(car);
   sensors::Imu imu(ip, seed * 3 + 1);
   sensors::WheelSpeedSensor wheels({}, seed * 3 + 2);
   sensors::SteeringSensor steering({}, seed * 3 + 3);
@@ -69,7 +70,7 @@ DriveLog drive(const vehicle::VehicleParams& car, vehicle::VehicleState s, const
   Vec2 last = vehicle::base_pose(car, s).position();
   for (int k = 1; k <= steps; ++k) {
     const double t = k * kDt;
-    vehicle::step(car, s, profile(t), kDt);
+    vehicle::step(compiled, s, profile(t), kDt);
     const TimeNs now = k * kStepNs;
     const Pose2 base = vehicle::base_pose(car, s);
     run.distance += distance(base.position(), last);
