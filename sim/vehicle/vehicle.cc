@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "autonomy/common/simd_math.h"
+#include "sim/vehicle/tyre_tables.h"
 
 namespace paddock::vehicle {
 
@@ -63,19 +64,44 @@ namespace {
 
 using simd::D4;
 
+// every lane true
+PADDOCK_SIMD_INLINE bool all(simd::M4 m) { return (m[0] & m[1] & m[2] & m[3]) != 0; }
+
+// Pacejka's curve without shifts, g(X) = sin(C atan(X - E (X - atan X))),
+// over the normalised slip X, g(X) / X lane by lane at x2 = X^2 (C at 0):
+// from the car's table (tables: null for the curve as written), the curve
+// as written in a lane beyond the table
+PADDOCK_SIMD_INLINE D4 curve_ratio(const VehicleParams& p, const TyreTables* tables, D4 x2) {
+  const auto written = [&p, x2] {
+    const D4 x = {std::sqrt(x2[0]), std::sqrt(x2[1]), std::sqrt(x2[2]), std::sqrt(x2[3])};
+    const D4 g = simd::sin(p.tyre_c * simd::atan(x - p.tyre_e * (x - simd::atan(x))));
+    return simd::select(x == 0.0, simd::splat(p.tyre_c), g / x);
+  };
+  if (!tables) return written();
+  const D4 r = tables->curve_ratio(x2);
+  const simd::M4 inside = x2 < EvenTable::kMax;
+  return all(inside) ? r : simd::select(inside, r, written());
+}
+
+// the slip angle atan(t) lane by lane, likewise
+PADDOCK_SIMD_INLINE D4 slip_angle(const TyreTables* tables, D4 t) {
+  if (!tables) return simd::atan(t);
+  const D4 s = t * t;
+  const D4 a = t * tables->atan_ratio(s);
+  const simd::M4 inside = s < EvenTable::kMax;
+  return all(inside) ? a : simd::select(inside, a, simd::atan(t));
+}
+
 // four tyres' forces at once (lane i: wheel i), see tyre_force; the load
-// factor's lanes out in mu (times fz: the friction the wheel has). Pacejka's
-// curve without shifts, g(X) = sin(C atan(X - E (X - atan X))), g'(0) = C
-PADDOCK_SIMD_INLINE void tyre_lanes(const VehicleParams& p, D4 kappa, D4 alpha, D4 fz, D4& fx, D4& fy, D4& mu) {
+// factor's lanes out in mu (times fz: the friction the wheel has)
+PADDOCK_SIMD_INLINE void tyre_lanes(const VehicleParams& p, const TyreTables* tables, D4 kappa, D4 alpha, D4 fz,
+                                    D4& fx, D4& fy, D4& mu) {
   const D4 xs = p.tyre_bx * kappa;
   const D4 ys = p.tyre_b * alpha;
-  const D4 x2 = xs * xs + ys * ys;
-  const D4 x = {std::sqrt(x2[0]), std::sqrt(x2[1]), std::sqrt(x2[2]), std::sqrt(x2[3])};
-  const D4 g = simd::sin(p.tyre_c * simd::atan(x - p.tyre_e * (x - simd::atan(x))));
   // load_factor's max(0, .) as std::max(0, v): v unless 0 < v is false
   const D4 lf = 1.0 + p.tyre_load_sensitivity * (fz / p.tyre_load_nominal - 1.0);
   mu = simd::select(0.0 < lf, lf, simd::splat(0.0)) * fz;
-  const D4 k = simd::select((x == 0.0) | (fz <= 0.0), simd::splat(0.0), mu * g / x);
+  const D4 k = simd::select(fz <= 0.0, simd::splat(0.0), mu * curve_ratio(p, tables, xs * xs + ys * ys));
   fx = p.tyre_dx * k * xs;
   fy = -p.tyre_d * k * ys;
 }
@@ -84,7 +110,13 @@ PADDOCK_SIMD_INLINE void tyre_lanes(const VehicleParams& p, D4 kappa, D4 alpha, 
 
 TyreForce tyre_force(const VehicleParams& p, double kappa, double alpha, double fz) {
   D4 fx, fy, mu;
-  tyre_lanes(p, simd::splat(kappa), simd::splat(alpha), simd::splat(fz), fx, fy, mu);
+  tyre_lanes(p, nullptr, simd::splat(kappa), simd::splat(alpha), simd::splat(fz), fx, fy, mu);
+  return {fx[0], fy[0]};
+}
+
+TyreForce tyre_force(const Car& car, double kappa, double alpha, double fz) {
+  D4 fx, fy, mu;
+  tyre_lanes(car.params(), car.tyres(), simd::splat(kappa), simd::splat(alpha), simd::splat(fz), fx, fy, mu);
   return {fx[0], fy[0]};
 }
 
@@ -220,6 +252,7 @@ namespace {
 // start decides
 struct Model : CarConstants {
   const VehicleParams* p;
+  const TyreTables* tyres;  // null: the curve as written
   std::array<double, 4> tv_torque;     // N m, torque vectoring shift
   std::array<double, 4> traction;      // traction control's torque factor, held over the step
   std::array<double, 4> friction_sign;  // 0: held at rest; +-1: friction opposes that spin
@@ -322,8 +355,8 @@ PADDOCK_SIMD_INLINE Deriv derivative_body(const Model& m, const X& s) {
   {
     const D4 load = simd::load(fz);
     D4 fx4, fy4, mu;
-    tyre_lanes(p, simd::load(s.ux.data()) * m.inv_sigma_x, simd::atan(simd::load(s.uy.data()) * m.inv_sigma_y), load,
-               fx4, fy4, mu);
+    tyre_lanes(p, m.tyres, simd::load(s.ux.data()) * m.inv_sigma_x,
+               slip_angle(m.tyres, simd::load(s.uy.data()) * m.inv_sigma_y), load, fx4, fy4, mu);
     const D4 vx4 = simd::load(vcx);
     const D4 low = 1.0 - simd::abs(vx4) * (1.0 / kLowSpeed);
     const D4 k = low * min_lanes(simd::splat(1.0), load * simd::load(m.inv_fz_static.data()));
@@ -522,7 +555,15 @@ CarConstants car_constants(const VehicleParams& p) {
 
 }  // namespace
 
-Car::Car(const VehicleParams& p) : p_(p), constants_(std::make_shared<const CarConstants>(car_constants(p))) {}
+// the tyre tables are kept when they meet the curve within this (relative;
+// they reach 1.1e-14 over the whole range of C and E); otherwise the car
+// takes the curve as written
+constexpr double kTableTolerance = 1e-13;
+
+Car::Car(const VehicleParams& p) : p_(p), constants_(std::make_shared<const CarConstants>(car_constants(p))) {
+  auto tables = std::make_shared<const TyreTables>(p.tyre_c, p.tyre_e);
+  if (tables->error <= kTableTolerance) tyres_ = std::move(tables);
+}
 
 namespace {
 
@@ -533,6 +574,7 @@ Model make_model(const Car& car, const VehicleState& s, const DriverInput& in, d
   Model m;
   static_cast<CarConstants&>(m) = car.constants();
   m.p = &p;
+  m.tyres = car.tyres();
   const double yaw_moment = finite_or(in.yaw_moment, 0.0);
   const double sd = std::sin(s.steering), cd = std::cos(s.steering);
   for (std::size_t i = 0; i < 4; ++i) {

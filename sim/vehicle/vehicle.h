@@ -209,6 +209,8 @@ VehicleState rolling_state(const VehicleParams& p, Pose2 base_pose, double speed
 
 // what a car's parameters imply for every step (vehicle.cc)
 struct CarConstants;
+// its tyre curve as tables (tyre_tables.h)
+struct TyreTables;
 
 // a car ready to be stepped: its parameters and what step() derives from them
 // once (as MuJoCo compiles its mjModel). A value: copies share the constant part
@@ -217,10 +219,14 @@ class Car {
   explicit Car(const VehicleParams& p);
   const VehicleParams& params() const { return p_; }
   const CarConstants& constants() const { return *constants_; }
+  // the tyre curve's tables, or null where they miss the curve (it is then
+  // computed as written)
+  const TyreTables* tyres() const { return tyres_.get(); }
 
  private:
   VehicleParams p_;
   std::shared_ptr<const CarConstants> constants_;
+  std::shared_ptr<const TyreTables> tyres_;
 };
 
 // one fixed step of length dt (s): RK4 over the whole state (rigid body and actuators)
@@ -244,6 +250,9 @@ struct TyreForce {
   double fy = 0.0;
 };
 TyreForce tyre_force(const VehicleParams& p, double kappa, double alpha, double fz);
+// the same as step() computes it: the curve from the car's tables (within
+// 1e-13 of the above, relative)
+TyreForce tyre_force(const Car& car, double kappa, double alpha, double fz);
 // the pure lateral force: tyre_force(p, 0, alpha, fz).fy
 double tyre_lateral_force(const VehicleParams& p, double alpha, double fz);
 
