@@ -1,5 +1,6 @@
 #include "autonomy/slam/cone_map.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -10,30 +11,47 @@ ConeColor MappedCone::color() const { return most_voted(votes); }
 ConeMap::ConeMap(const ConeMapParams& params) : params_(params) {}
 
 void ConeMap::add(const std::vector<Cone>& detections) {
-  const double gate2 = params_.association_distance * params_.association_distance;
-  // each mapped cone takes at most one detection of a frame (a frame sees a cone once)
-  std::vector<char> taken(cones_.size(), 0);
+  const double gate = params_.association_distance;
+  const double gate2 = gate * gate;
+  // the mapped cones a detection can reach: those within the gate of the
+  // frame's bounding box, in the map's order (a frame covers a small part of
+  // the map; a cone this frame adds is taken at once, so never a candidate)
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   for (const Cone& d : detections) {
     if (!std::isfinite(d.position.x) || !std::isfinite(d.position.y)) continue;
-    // nearest free mapped cone within the gate (brute force: a few hundred cones)
-    std::size_t best = cones_.size();
+    x0 = std::min(x0, d.position.x);
+    y0 = std::min(y0, d.position.y);
+    x1 = std::max(x1, d.position.x);
+    y1 = std::max(y1, d.position.y);
+  }
+  const double reach = gate * (1.0 + 1e-9);  // a hair wider than the gate: never one too few
+  candidates_.clear();
+  for (std::size_t i = 0; i < cones_.size(); ++i) {
+    const Vec2 p = cones_[i].position;
+    if (p.x >= x0 - reach && p.x <= x1 + reach && p.y >= y0 - reach && p.y <= y1 + reach) candidates_.push_back(i);
+  }
+  // each mapped cone takes at most one detection of a frame (a frame sees a cone once)
+  taken_.assign(candidates_.size(), 0);
+  for (const Cone& d : detections) {
+    if (!std::isfinite(d.position.x) || !std::isfinite(d.position.y)) continue;
+    // the nearest free mapped cone within the gate (the first of equals)
+    std::size_t best = cones_.size(), best_k = 0;
     double best_d2 = gate2;
-    for (std::size_t i = 0; i < taken.size(); ++i) {
-      if (taken[i]) continue;
-      const double d2 = squared_norm(cones_[i].position - d.position);
+    for (std::size_t k = 0; k < candidates_.size(); ++k) {
+      if (taken_[k]) continue;
+      const double d2 = squared_norm(cones_[candidates_[k]].position - d.position);
       if (d2 < best_d2) {
         best_d2 = d2;
-        best = i;
+        best = candidates_[k];
+        best_k = k;
       }
     }
     if (best == cones_.size()) {
       MappedCone m;
       m.position = d.position;
       cones_.push_back(m);
-      taken.push_back(1);
-      best = cones_.size() - 1;
     } else {
-      taken[best] = 1;
+      taken_[best_k] = 1;
       // running mean: p_n = p_{n-1} + (x - p_{n-1}) / n
       MappedCone& m = cones_[best];
       m.position += (d.position - m.position) / static_cast<double>(m.observations + 1);

@@ -75,6 +75,9 @@ class ConeMap {
  private:
   ConeMapParams params_;
   std::vector<MappedCone> cones_;
+  // add()'s scratch: the mapped cones near a frame, and which of them it took
+  std::vector<std::size_t> candidates_;
+  std::vector<char> taken_;
 };
 
 }  // namespace paddock::slam

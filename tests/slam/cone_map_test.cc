@@ -35,6 +35,75 @@ TEST(ConeMap, RepeatedNoisyDetectionsAverageToTheTruth) {
   }
 }
 
+// the map as the plain rule builds it: each detection to the nearest free
+// mapped cone within the gate (the first of equals), scanning every cone
+std::vector<MappedCone> brute_force_map(const std::vector<std::vector<Cone>>& frames, double gate) {
+  std::vector<MappedCone> map;
+  for (const std::vector<Cone>& frame : frames) {
+    std::vector<char> taken(map.size(), 0);
+    for (const Cone& d : frame) {
+      if (!std::isfinite(d.position.x) || !std::isfinite(d.position.y)) continue;
+      std::size_t best = map.size();
+      double best_d2 = gate * gate;
+      for (std::size_t i = 0; i < taken.size(); ++i) {
+        const double d2 = squared_norm(map[i].position - d.position);
+        if (!taken[i] && d2 < best_d2) {
+          best_d2 = d2;
+          best = i;
+        }
+      }
+      if (best == map.size()) {
+        map.push_back({d.position, 0, {}});
+        taken.push_back(1);
+      } else {
+        taken[best] = 1;
+        map[best].position += (d.position - map[best].position) / static_cast<double>(map[best].observations + 1);
+      }
+      ++map[best].observations;
+      ++map[best].votes[static_cast<std::size_t>(d.color)];
+    }
+  }
+  return map;
+}
+
+TEST(ConeMap, AssociatesAsTheNearestFreeConeOverTheWholeMap) {
+  // a car's frames down a 400 m row of cone pairs: 20 m of view, noise, ghosts,
+  // a cone seen twice in a frame, NaN; the map equals the brute force's, bit for bit
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::vector<Cone>> frames;
+  for (double x = 0.0; x < 400.0; x += 1.3) {
+    std::vector<Cone> frame;
+    for (double c = 0.0; c < 400.0; c += 4.0) {
+      if (c < x || c > x + 20.0) continue;
+      for (const double y : {-1.6, 1.6}) {
+        if (u(rng) < 0.1) continue;  // missed
+        frame.push_back({{c + noise(rng), y + noise(rng)}, u(rng) < 0.5 ? ConeColor::Blue : ConeColor::Unknown});
+        if (u(rng) < 0.05) frame.push_back({{c + noise(rng), y + noise(rng)}, ConeColor::Yellow});  // twice
+      }
+    }
+    if (u(rng) < 0.2) frame.push_back({{x + 30.0 * u(rng), 10.0 * u(rng) - 5.0}, ConeColor::Unknown});  // a ghost
+    if (u(rng) < 0.05) frame.push_back({{std::nan(""), 0.0}, ConeColor::Blue});
+    frames.push_back(frame);
+  }
+  for (const double gate : {0.5, 1.0, 2.5}) {
+    ConeMapParams p;
+    p.association_distance = gate;
+    ConeMap map(p);
+    for (const std::vector<Cone>& f : frames) map.add(f);
+    const std::vector<MappedCone> expected = brute_force_map(frames, gate);
+    ASSERT_EQ(map.all().size(), expected.size()) << "gate " << gate;
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+      ASSERT_EQ(map.all()[i].position.x, expected[i].position.x) << i;
+      ASSERT_EQ(map.all()[i].position.y, expected[i].position.y) << i;
+      ASSERT_EQ(map.all()[i].observations, expected[i].observations) << i;
+      ASSERT_EQ(map.all()[i].votes, expected[i].votes) << i;
+    }
+    EXPECT_GT(expected.size(), 200u);
+  }
+}
+
 TEST(ConeMap, ColourIsTheMajorityOfTheColouredVotes) {
   ConeMap map;
   for (int f = 0; f < 10; ++f) {
