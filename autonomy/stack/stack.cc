@@ -370,9 +370,20 @@ double Stack::finish_approach_cap(Vec2 base) const {
     gates_projected_ = gates_;
     gates_projected_version_ = trajectory_version_;
   }
+  // the car's place on the path: around last cycle's on the same trajectory
+  // (as the controller's), a full search the first time or when that misses
+  const control::ControlParams& cp = params_.control;
+  TrajectoryProjection car;
+  if (car_projected_version_ == trajectory_version_) {
+    car = project(trajectory_, base, car_s_, cp.projection_window);
+    if (std::abs(car.offset) > cp.relocalize_distance) car = project(trajectory_, base, 0.0, 0.0);
+  } else {
+    car = project(trajectory_, base, 0.0, 0.0);
+  }
+  car_s_ = car.s;
+  car_projected_version_ = trajectory_version_;
   // braking at stop_decel_max (less in turns) to the finish speed that stops
   // in stop_distance
-  const TrajectoryProjection car = project(trajectory_, base, 0.0, 0.0);
   double cap = kInf;
   for (const GateOnPath& gate : gates_on_path_) {
     if (std::abs(gate.offset) > mp.gate_max_offset) continue;  // not a gate on this path

@@ -307,6 +307,9 @@ class Stack {
   mutable std::vector<GateOnPath> gates_on_path_;
   mutable std::vector<Segment> gates_projected_;
   mutable std::uint64_t gates_projected_version_ = 0;
+  // and the car's arc length on it last cycle, for that trajectory version
+  mutable double car_s_ = 0.0;
+  mutable std::uint64_t car_projected_version_ = 0;
   control::Controller controller_;
   Telemetry telemetry_;
   Profile* profile_ = nullptr;
