@@ -294,7 +294,9 @@ SimState::SimState(const SimModel& model, WireTap* tap)
   stack.set_profile(&profile);
   if (raw) raw->set_profile(&profile);
   faults.place(model.track, model.cones);
-  run_due(model, *this, vehicle::base_pose(model.scenario.vehicle, car));
+  const Pose2 base = vehicle::base_pose(model.scenario.vehicle, car);
+  nose = base.transform({model.footprint.x_max, 0.0});
+  run_due(model, *this, base);
 }
 
 namespace {
@@ -304,8 +306,6 @@ namespace {
 std::optional<Pose2> physics_step(const SimModel& model, SimState& s) {
   const StageScope physics(&s.profile, Stage::Physics);
   const vehicle::VehicleParams& car = model.scenario.vehicle;
-  const double nose_x = model.footprint.x_max;
-  const Vec2 nose0 = vehicle::base_pose(car, s.car).transform({nose_x, 0.0});
   // in the rain ([faults.rain]) the tyres grip less
   const double grip = s.faults.grip(s.t);
   if (grip < 1.0 && !s.wet) {
@@ -328,8 +328,12 @@ std::optional<Pose2> physics_step(const SimModel& model, SimState& s) {
     s.controlled = s.sampled = false;
     return std::nullopt;
   }
-  const Pose2 base = vehicle::base_pose(car, s.car);
-  const Vec2 v_world = rotate(vehicle::base_velocity(car, s.car), base.yaw);
+  // the base pose, its heading's cosine and sine taken once (vehicle::base_pose,
+  // rotate and Pose2::transform would each take them again: the same bits)
+  const double c = std::cos(s.car.yaw), sn = std::sin(s.car.yaw);
+  const Pose2 base{s.car.x - car.lr * c, s.car.y - car.lr * sn, s.car.yaw};
+  const auto rotated = [c, sn](Vec2 v) { return Vec2{c * v.x - sn * v.y, sn * v.x + c * v.y}; };
+  const Vec2 v_world = rotated(vehicle::base_velocity(car, s.car));
   // a gust ([faults.wind]) moves cones: not the car's doing
   for (const FaultInjector::Gust& g : s.faults.gust_due(s.t)) s.cones.disturb_cone(g.cone, g.shift, g.topple);
   s.cones.step(base, v_world.x, v_world.y, s.car.r, model.dt);
@@ -338,7 +342,9 @@ std::optional<Pose2> physics_step(const SimModel& model, SimState& s) {
   ++s.k;
   s.now = s.k * model.dt_ns;
   s.t = static_cast<double>(s.k) * model.dt;
-  s.event.on_motion(t0, nose0, t0 + model.dt, base.transform({nose_x, 0.0}));
+  const Vec2 nose0 = s.nose;
+  s.nose = base.position() + rotated({model.footprint.x_max, 0.0});
+  s.event.on_motion(t0, nose0, t0 + model.dt, s.nose);
   return base;
 }
 

@@ -80,6 +80,7 @@ struct SimState {
   bool done = false;  // the event is over (finish or DNF): step no more
 
   vehicle::VehicleState car;
+  Vec2 nose;  // the car's nose in the map now (where the next step's motion starts)
   world::ConeWorld cones;
   events::Event event;
   stack::Stack stack;
