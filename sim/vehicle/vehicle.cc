@@ -309,7 +309,7 @@ PADDOCK_SIMD_INLINE D4 clamp_lanes(D4 v, D4 lo, D4 hi) {
 // for AVX2 and for baseline x86-64, with the same result (see below)
 PADDOCK_SIMD_INLINE Deriv derivative_body(const Model& m, const X& s) {
   const VehicleParams& p = *m.p;
-  Deriv out{};
+  Deriv out;  // every field is set below (zeroing it first cost a rep stos a derivative)
   X& d = out.d;
 
   // actuators: first-order lags, steering also rate limited
