@@ -42,11 +42,27 @@ void PerceptionMetrics::add(const hal::ConeDetections& perceived, const Pose2& b
   std::vector<Vec2> seen(perceived.cones.size());
   for (std::size_t i = 0; i < seen.size(); ++i) seen[i] = base_pose.transform(perceived.cones[i].position);
 
-  // candidate pairs within the radius, nearest first
+  // the true cones within the radius of the frame's bounding box (a frame
+  // sees a small part of the track), then the candidate pairs within the
+  // radius, nearest first
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  for (const Vec2& p : seen) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
+    x0 = std::min(x0, p.x);
+    y0 = std::min(y0, p.y);
+    x1 = std::max(x1, p.x);
+    y1 = std::max(y1, p.y);
+  }
+  const double reach = match_radius_ * (1.0 + 1e-9);  // a hair wider: never one too few
+  std::vector<std::size_t> near;
+  for (std::size_t j = 0; j < truth.size(); ++j) {
+    const Vec2 t = truth[j].position;
+    if (t.x >= x0 - reach && t.x <= x1 + reach && t.y >= y0 - reach && t.y <= y1 + reach) near.push_back(j);
+  }
   std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
   for (std::size_t i = 0; i < seen.size(); ++i) {
     if (!std::isfinite(seen[i].x) || !std::isfinite(seen[i].y)) continue;
-    for (std::size_t j = 0; j < truth.size(); ++j) {
+    for (const std::size_t j : near) {
       // (a coordinate apart by more than the radius is out: hypot is never
       // below either one; most of the track's cones are, and hypot is slow)
       const Vec2 e = seen[i] - truth[j].position;

@@ -96,6 +96,7 @@ struct SimState {
   std::optional<vehicle::Car> wet;  // the car in the rain ([faults.rain]), once it rains
   int control_cycles = 0;
   // what the current instant ran
+  bool sensed = false;      // a sensor frame: the cone sensor's, or a LiDAR rotation (and its camera frame)
   bool controlled = false;  // a control cycle
   bool sampled = false;     // the event's sample (and a log row)
 
