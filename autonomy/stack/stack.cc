@@ -344,12 +344,14 @@ void Stack::catch_up(const hal::StateEstimate& st) {
     pts[i].speed = speed[i];
     if (k + 1 < lowered) ramp += ds[i];
   }
+  ++speeds_version_;
   catch_up_until_ = driven_ + ramp;
 }
 
 void Stack::set_trajectory(Trajectory t) {
   trajectory_ = std::move(t);
   ++trajectory_version_;
+  ++speeds_version_;
 }
 
 double Stack::finish_approach_cap(Vec2 base) const {
@@ -401,8 +403,12 @@ double Stack::stop_speed_cap(double s, double to_rest, double a) const {
   // (none where the turn takes all of a: there the cap stays under
   // sqrt(a / |kappa|)); an open path's last curvature goes on past its end
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  double top = 0.0;
-  for (const TrajectoryPoint& p : trajectory_.points) top = std::max(top, p.speed);
+  if (top_version_ != speeds_version_) {
+    top_speed_ = 0.0;
+    for (const TrajectoryPoint& p : trajectory_.points) top_speed_ = std::max(top_speed_, p.speed);
+    top_version_ = speeds_version_;
+  }
+  const double top = top_speed_;
   constexpr double kStep = 0.25;  // m
   const int steps = std::max(1, static_cast<int>(std::ceil(to_rest / kStep)));
   const double h = to_rest / steps;
@@ -640,6 +646,7 @@ void Stack::tick(TimeNs now, hal::Hal& hal) {
     // caught up: the lap's own speeds from here on
     for (std::size_t i = 0; i < trajectory_.points.size() && i < lap_speed_.size(); ++i)
       trajectory_.points[i].speed = lap_speed_[i];
+    ++speeds_version_;
     catch_up_until_.reset();
   }
   driven_ += speed * dt;

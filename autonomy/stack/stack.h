@@ -298,6 +298,10 @@ class Stack {
   MissionSpec spec_;
   Trajectory trajectory_;
   std::uint64_t trajectory_version_ = 0;  // counts set_trajectory()
+  std::uint64_t speeds_version_ = 0;      // counts every change of its speeds (set_trajectory() too)
+  // stop_speed_cap's highest speed of the trajectory, for speeds version top_version_
+  mutable double top_speed_ = 0.0;
+  mutable std::uint64_t top_version_ = 0;
   // finish_approach_cap's gates on trajectory_ (arc length, offset), kept
   // for the trajectory version and the gates they were projected for (at
   // first none, for version 0: no trajectory, nothing asked)
