@@ -38,19 +38,21 @@ Cell cell_bounds(int cell) {
 }  // namespace
 
 double EvenTable::build(const std::function<long double(long double)>& f) {
+  // the Chebyshev nodes u_j = cos(pi (j + 1/2) / N) and T_k(u_j) = cos(pi k (j + 1/2) / N)
+  std::array<std::array<long double, kNodes>, kNodes> basis{};
+  for (int k = 0; k < kNodes; ++k)
+    for (int j = 0; j < kNodes; ++j) basis[k][j] = std::cos(static_cast<long double>(M_PI) * k * (j + 0.5L) / kNodes);
   double worst = 0.0;
   for (int cell = 0; cell < kCells; ++cell) {
     const Cell b = cell_bounds(cell);
     // Chebyshev interpolation on the cell, u = (s - centre) / half in [-1, 1]
     std::array<long double, kNodes> value{};
-    for (int j = 0; j < kNodes; ++j) {
-      const long double u = std::cos(static_cast<long double>(M_PI) * (j + 0.5L) / kNodes);
-      value[j] = f(static_cast<long double>(b.centre) + static_cast<long double>(b.half) * u);
-    }
+    for (int j = 0; j < kNodes; ++j)
+      value[j] = f(static_cast<long double>(b.centre) + static_cast<long double>(b.half) * basis[1][j]);
     std::array<long double, kNodes> cheb{};
     for (int k = 0; k < kNodes; ++k) {
       long double sum = 0.0L;
-      for (int j = 0; j < kNodes; ++j) sum += value[j] * std::cos(static_cast<long double>(M_PI) * k * (j + 0.5L) / kNodes);
+      for (int j = 0; j < kNodes; ++j) sum += value[j] * basis[k][j];
       cheb[k] = (k == 0 ? 1.0L : 2.0L) * sum / kNodes;
     }
     // sum_k cheb_k T_k(u) as powers of u (T_{k+1} = 2 u T_k - T_{k-1}), then of
