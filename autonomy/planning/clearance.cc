@@ -1,5 +1,6 @@
 #include "autonomy/planning/clearance.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace paddock::planning {
@@ -32,27 +33,50 @@ int clear_trajectory(std::vector<Vec2>& points, const Trajectory& traj, const st
   // each point's push: the largest shortfall of a sample near it, away from that sample's cone
   std::vector<double> shortfall(points.size(), 0.0);
   std::vector<Vec2> away(points.size());
-  for (const TrajectoryPoint& s : traj.points) {
-    const Vec2 p = s.position();
-    // squared distances: this runs over every sample and every cone
-    const Cone* nearest = nullptr;
-    double best2 = (params.clearance - tolerance) * (params.clearance - tolerance);
-    for (const Cone& c : cones) {
-      const double d2 = squared_norm(p - c.position);
-      if (d2 < best2) {
-        best2 = d2;
-        nearest = &c;
-      }
+  // the samples in runs of kRun along the path: a run's candidate cones are
+  // those within the clearance of its bounding box, in the cones' order (a
+  // hair wider: never one too few), so each sample finds the nearest cone as
+  // a pass over every cone would, the first of equals
+  constexpr std::size_t kRun = 32;
+  const double gate = params.clearance - tolerance;
+  const double reach_box = std::abs(gate) * (1.0 + 1e-9);
+  std::vector<const Cone*> near;
+  for (std::size_t first = 0; first < traj.points.size(); first += kRun) {
+    const std::size_t last = std::min(traj.points.size(), first + kRun);
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (std::size_t k = first; k < last; ++k) {
+      x0 = std::min(x0, traj.points[k].x);
+      y0 = std::min(y0, traj.points[k].y);
+      x1 = std::max(x1, traj.points[k].x);
+      y1 = std::max(y1, traj.points[k].y);
     }
-    if (!nearest) continue;
-    const double missing = params.clearance - std::sqrt(best2);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (squared_norm(points[i] - p) > reach * reach || missing <= shortfall[i]) continue;
-      const Vec2 d = points[i] - nearest->position;
-      const double n = norm(d);
-      if (n < 1e-9) continue;
-      shortfall[i] = missing;
-      away[i] = d / n;
+    near.clear();
+    for (const Cone& c : cones) {
+      const Vec2 q = c.position;
+      if (q.x >= x0 - reach_box && q.x <= x1 + reach_box && q.y >= y0 - reach_box && q.y <= y1 + reach_box)
+        near.push_back(&c);
+    }
+    for (std::size_t k = first; k < last; ++k) {
+      const Vec2 p = traj.points[k].position();
+      const Cone* nearest = nullptr;
+      double best2 = gate * gate;
+      for (const Cone* c : near) {
+        const double d2 = squared_norm(p - c->position);
+        if (d2 < best2) {
+          best2 = d2;
+          nearest = c;
+        }
+      }
+      if (!nearest) continue;
+      const double missing = params.clearance - std::sqrt(best2);
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        if (squared_norm(points[i] - p) > reach * reach || missing <= shortfall[i]) continue;
+        const Vec2 d = points[i] - nearest->position;
+        const double n = norm(d);
+        if (n < 1e-9) continue;
+        shortfall[i] = missing;
+        away[i] = d / n;
+      }
     }
   }
   int moved = 0;
