@@ -95,9 +95,10 @@ double EvenTable::at(double s) const {
   const double centre = first ? 0.5 * kFirst : from_bits((bits & static_cast<std::uint64_t>(kTopMask)) | kHalfBit);
   const double d = v - centre;
   const std::array<double, kDegree + 1>& c = c_[static_cast<std::size_t>(cell)];
-  double p = c[kDegree];
-  for (int k = kDegree - 1; k >= 0; --k) p = p * d + c[k];
-  return p;
+  const double d2 = d * d;
+  const double d4 = d2 * d2;
+  const double p01 = c[0] + c[1] * d, p23 = c[2] + c[3] * d, p45 = c[4] + c[5] * d, p67 = c[6] + c[7] * d;
+  return (p01 + p23 * d2) + (p45 + p67 * d2) * d4;
 }
 
 TyreTables::TyreTables(double c, double e) {

@@ -12,13 +12,15 @@
 // A table holds a polynomial of degree 7 in (s - its centre) on each cell:
 // [0, 2^-8], then 16 cells per octave up to 2^6 (X, t < 8: the slip caps keep
 // the tyres' arguments below 5.7), found from the bits of s (exponent and top
-// four mantissa bits) with no search and no division. Each polynomial is the
-// Chebyshev interpolant of the function (in long double) on its cell; the
-// build measures the table against the function between the nodes. Measured
-// (tests/vehicle/tyre_tables_test.cc): atan_ratio within 1.2e-15 relative,
-// curve_ratio within 2e-15 for the shipped cars and 1.1e-14 at the corner
-// of the parameter box (C = 2, E = -5). Evaluation is elementwise IEEE arithmetic without FMA, like
-// simd_math.h: the AVX2 and baseline builds of the vehicle give the same bits.
+// four mantissa bits) with no search and no division, and evaluated by
+// Estrin's scheme (a chain of three multiply-adds, not Horner's seven). Each
+// polynomial is the Chebyshev interpolant of the function (in long double)
+// on its cell; the build measures the table against the function between
+// the nodes. Measured (tests/vehicle/tyre_tables_test.cc): atan_ratio
+// within 1.2e-15 relative, curve_ratio within 2e-15 for the shipped cars
+// and 1.1e-14 at the corner of the parameter box (C = 2, E = -5).
+// Evaluation is elementwise IEEE arithmetic without FMA, like simd_math.h:
+// the AVX2 and baseline builds of the vehicle give the same bits.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -56,9 +58,12 @@ class EvenTable {
     const double* r1 = c_[static_cast<std::size_t>(cell[1])].data();
     const double* r2 = c_[static_cast<std::size_t>(cell[2])].data();
     const double* r3 = c_[static_cast<std::size_t>(cell[3])].data();
-    D4 p = {r0[kDegree], r1[kDegree], r2[kDegree], r3[kDegree]};
-    for (int k = kDegree - 1; k >= 0; --k) p = p * d + D4{r0[k], r1[k], r2[k], r3[k]};
-    return p;
+    const auto c = [r0, r1, r2, r3](int k) { return D4{r0[k], r1[k], r2[k], r3[k]}; };
+    // Estrin's scheme: the pairs, then their pairs (a shorter chain than Horner's)
+    const D4 d2 = d * d;
+    const D4 d4 = d2 * d2;
+    const D4 p01 = c(0) + c(1) * d, p23 = c(2) + c(3) * d, p45 = c(4) + c(5) * d, p67 = c(6) + c(7) * d;
+    return (p01 + p23 * d2) + (p45 + p67 * d2) * d4;
   }
 
   // the same for one s, as the lanes compute it (for the build's check)
