@@ -23,6 +23,7 @@
 #include "autonomy/common/params.h"
 #include "autonomy/hal/messages.h"
 #include "sim/sensors/camera.h"
+#include "sim/sensors/gaussian.h"
 
 namespace paddock::sensors {
 
@@ -133,7 +134,7 @@ class AnnotationDetector {
   DetectorParams params_;
   std::mt19937_64 rng_;
   std::uniform_real_distribution<double> uniform_{0.0, 1.0};
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  Gaussian normal_{0.0, 1.0};
 };
 
 }  // namespace paddock::sensors

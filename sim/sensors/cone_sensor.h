@@ -21,6 +21,7 @@
 #include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
 #include "autonomy/hal/messages.h"
+#include "sim/sensors/gaussian.h"
 
 namespace paddock::sensors {
 
@@ -199,7 +200,7 @@ class ConeSensor {
 
   ConeSensorParams params_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  Gaussian normal_{0.0, 1.0};
   ConeSensorFrameStats stats_;
   std::vector<bool> visible_;
   // scratch, kept to avoid allocating every frame

@@ -21,6 +21,7 @@
 
 #include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
+#include "sim/sensors/gaussian.h"
 
 namespace paddock::sensors {
 
@@ -133,9 +134,9 @@ class Imu {
 
   ImuParams params_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  Gaussian normal_{0.0, 1.0};
   std::mt19937_64 rng_3d_;  // the out-of-plane axes'
-  std::normal_distribution<double> normal_3d_{0.0, 1.0};
+  Gaussian normal_3d_{0.0, 1.0};
   ImuBias bias_;
   bool has_previous_ = false;
   TimeNs previous_stamp_ = 0;

@@ -13,6 +13,7 @@
 
 #include "autonomy/common/params.h"
 #include "autonomy/common/time.h"
+#include "sim/sensors/gaussian.h"
 
 namespace paddock::sensors {
 
@@ -71,7 +72,7 @@ class WheelSpeedSensor {
  private:
   WheelSpeedParams params_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  Gaussian normal_{0.0, 1.0};
 };
 
 // every field is the INI key `[steering_sensor] <field>`. The angle is the
@@ -128,7 +129,7 @@ class SteeringSensor {
  private:
   SteeringSensorParams params_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  Gaussian normal_{0.0, 1.0};
 };
 
 }  // namespace paddock::sensors

@@ -389,31 +389,36 @@ TEST(VelocityEkfTest, LockedWheelsUnderFullBrakingAreRejected) {
     in.brake = t < 1.0 ? 0.0 : 1.0;
     return in;
   };
-  const DriveLog run = drive(car, vehicle::rolling_state(car, Pose2{}, 20.0), full_brake, 4.0, 3);
-  // the estimator starts at vx = 0 on a car rolling at 20 m/s: the first wheel
-  // message acquires the speed (checked after 0.1 s), the brakes go on at 1 s
-  double worst = 0.0, most_locked = 0.0;
-  std::size_t locked = 0, flagged = 0;
-  for (const Sample& s : run.samples) {
-    if (s.t >= 0.1) worst = std::max(worst, std::abs(s.est.vx - s.vx));
-    if (std::getenv("EKF_DUMP") && std::abs(s.est.vx - s.vx) > 0.1)
-      std::printf("t %.2f vx %.3f est %.3f used %d slip %.3f %.3f %.3f %.3f\n", s.t, s.vx, s.est.vx, s.est.wheels_used,
-                  s.slip[0], s.slip[1], s.slip[2], s.slip[3]);
-    const double slip = *std::min_element(s.slip.begin(), s.slip.end());
-    most_locked = std::min(most_locked, slip);
-    if (slip < -0.5) {
-      ++locked;
-      flagged += s.est.wheels_used < 4;
+  // six seeds of the sensors' noise: the largest error falls near 0.23 or
+  // near 0.34 m/s by the seed (16 seeds, with either normal generator the
+  // sensors have had), so one seed's figure says little
+  for (std::uint64_t seed = 1; seed <= 6; ++seed) {
+    const DriveLog run = drive(car, vehicle::rolling_state(car, Pose2{}, 20.0), full_brake, 4.0, seed);
+    // the estimator starts at vx = 0 on a car rolling at 20 m/s: the first wheel
+    // message acquires the speed (checked after 0.1 s), the brakes go on at 1 s
+    double worst = 0.0, most_locked = 0.0;
+    std::size_t locked = 0, flagged = 0;
+    for (const Sample& s : run.samples) {
+      if (s.t >= 0.1) worst = std::max(worst, std::abs(s.est.vx - s.vx));
+      if (std::getenv("EKF_DUMP") && std::abs(s.est.vx - s.vx) > 0.1)
+        std::printf("t %.2f vx %.3f est %.3f used %d slip %.3f %.3f %.3f %.3f\n", s.t, s.vx, s.est.vx,
+                    s.est.wheels_used, s.slip[0], s.slip[1], s.slip[2], s.slip[3]);
+      const double slip = *std::min_element(s.slip.begin(), s.slip.end());
+      most_locked = std::min(most_locked, slip);
+      if (slip < -0.5) {
+        ++locked;
+        flagged += s.est.wheels_used < 4;
+      }
     }
+    std::printf("seed %d lock: %zu samples with a wheel below -50 %% slip (lowest %.2f), %zu of them with a wheel "
+                "rejected; largest vx error %.3f m/s\n",
+                static_cast<int>(seed), locked, most_locked, flagged, worst);
+    EXPECT_GT(locked, 20u) << "the wheels must lock for the test to mean something";
+    EXPECT_EQ(flagged, locked) << "seed " << seed;
+    EXPECT_LT(worst, 0.36) << "seed " << seed;
+    EXPECT_LT(std::abs(run.samples[10].est.vx - run.samples[10].vx), 0.05) << "acquired within 0.1 s, seed " << seed;
+    EXPECT_LT(std::abs(run.samples.back().est.vx), 0.01) << "seed " << seed;
   }
-  std::printf("lock: %zu samples with a wheel below -50 %% slip (lowest %.2f), %zu of them with a wheel rejected; "
-              "largest vx error %.3f m/s\n",
-              locked, most_locked, flagged, worst);
-  EXPECT_GT(locked, 20u) << "the wheels must lock for the test to mean something";
-  EXPECT_EQ(flagged, locked);
-  EXPECT_LT(worst, 0.3);
-  EXPECT_LT(std::abs(run.samples[10].est.vx - run.samples[10].vx), 0.05) << "acquired within 0.1 s";
-  EXPECT_LT(std::abs(run.samples.back().est.vx), 0.01);
 }
 
 TEST(VelocityEkfTest, StandstillDoesNotDrift) {
