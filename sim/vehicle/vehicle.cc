@@ -250,7 +250,8 @@ namespace {
 
 // everything constant over one step: the car's constants, and what the step's
 // start decides
-struct Model : CarConstants {
+struct Model {
+  const CarConstants* k;  // the car's constants (not copied: 700 bytes a step)
   const VehicleParams* p;
   const TyreTables* tyres;  // null: the curve as written
   std::array<double, 4> tv_torque;     // N m, torque vectoring shift
@@ -268,26 +269,26 @@ inline double lag_rate(double tau, double dt) { return tau < 0.5 * dt ? 0.0 : 1.
 // the motors' torque at each wheel (N m) and the regeneration that replaces
 // friction braking, under the motor and power limits; returns the electrical power (W)
 double motor_torques(const Model& m, const X& s, std::array<double, 4>& torque, std::array<double, 4>& regen) {
-  const double request = s.thr * m.t_wheel_max;
+  const double request = s.thr * m.k->t_wheel_max;
   double p_drive = 0.0, p_regen = 0.0;
   for (std::size_t i = 0; i < 4; ++i) {
     regen[i] = 0.0;
     torque[i] = 0.0;
-    if (m.drive_share[i] == 0.0) continue;
+    if (m.k->drive_share[i] == 0.0) continue;
     const double w = s.w[i];
-    const double limit = m.drive_share[i] * m.t_wheel_max * std::clamp((m.w_max - std::abs(w)) * m.inv_fade, 0.0, 1.0);
-    double t = m.drive_share[i] * request * m.traction[i] + m.tv_torque[i];
-    if (m.regen_torque[i] > 0.0 && s.brk > 0.0) {
-      const double fade = std::clamp((std::abs(w) * m.radius - kRegenOff) * (1.0 / (kRegenFull - kRegenOff)), 0.0, 1.0);
-      regen[i] = std::min(m.regen_torque[i] * fade, s.brk * m.brake_torque[i]);
+    const double limit = m.k->drive_share[i] * m.k->t_wheel_max * std::clamp((m.k->w_max - std::abs(w)) * m.k->inv_fade, 0.0, 1.0);
+    double t = m.k->drive_share[i] * request * m.traction[i] + m.tv_torque[i];
+    if (m.k->regen_torque[i] > 0.0 && s.brk > 0.0) {
+      const double fade = std::clamp((std::abs(w) * m.k->radius - kRegenOff) * (1.0 / (kRegenFull - kRegenOff)), 0.0, 1.0);
+      regen[i] = std::min(m.k->regen_torque[i] * fade, s.brk * m.k->brake_torque[i]);
       t -= regen[i] * sign(w);
     }
     torque[i] = std::clamp(t, -limit, limit);
     const double pw = torque[i] * w;
     (pw > 0.0 ? p_drive : p_regen) += pw;
   }
-  const double k_drive = p_drive > m.p_wheel_max ? m.p_wheel_max / p_drive : 1.0;
-  const double k_regen = -p_regen > m.p_wheel_max ? m.p_wheel_max / -p_regen : 1.0;
+  const double k_drive = p_drive > m.k->p_wheel_max ? m.k->p_wheel_max / p_drive : 1.0;
+  const double k_regen = -p_regen > m.k->p_wheel_max ? m.k->p_wheel_max / -p_regen : 1.0;
   if (k_drive < 1.0 || k_regen < 1.0) {
     for (std::size_t i = 0; i < 4; ++i) {
       const double k = torque[i] * s.w[i] > 0.0 ? k_drive : k_regen;
@@ -295,7 +296,7 @@ double motor_torques(const Model& m, const X& s, std::array<double, 4>& torque, 
       regen[i] *= k_regen;
     }
   }
-  return p_drive * k_drive * m.inv_eta + p_regen * k_regen * m.eta;
+  return p_drive * k_drive * m.k->inv_eta + p_regen * k_regen * m.k->eta;
 }
 
 // std::min(a, b), std::clamp(v, lo, hi), lane by lane and alike for NaN
@@ -320,7 +321,7 @@ PADDOCK_SIMD_INLINE Deriv derivative_body(const Model& m, const X& s) {
   // aero: downforce and drag grow with vx^2; the lagged load transfer per wheel
   const double f_down = p.c_down * s.vx * s.vx;
   const double f_drag = p.c_drag * s.vx * std::abs(s.vx);
-  const double transfer = m.transfer_per_wheel * s.ax_load;
+  const double transfer = m.k->transfer_per_wheel * s.ax_load;
 
   std::array<double, 4> t_drive, regen;
   out.power = motor_torques(m, s, t_drive, regen);
@@ -339,12 +340,12 @@ PADDOCK_SIMD_INLINE Deriv derivative_body(const Model& m, const X& s) {
     const bool front = i < 2;
     c[i] = front ? cd : 1.0;
     sn[i] = front ? sd : 0.0;
-    const double vbx = s.vx - s.r * m.y[i];
-    const double vby = s.vy + s.r * m.x[i];
+    const double vbx = s.vx - s.r * m.k->y[i];
+    const double vby = s.vy + s.r * m.k->x[i];
     vcx[i] = c[i] * vbx + sn[i] * vby;
     vcy[i] = c[i] * vby - sn[i] * s.vx;
-    fz[i] = std::max(0.0, m.fz_static[i] + m.aero_share[i] * f_down + (front ? -transfer : transfer));
-    v_slip[i] = s.w[i] * m.radius - vcx[i];
+    fz[i] = std::max(0.0, m.k->fz_static[i] + m.k->aero_share[i] * f_down + (front ? -transfer : transfer));
+    v_slip[i] = s.w[i] * m.k->radius - vcx[i];
   }
 
   // the tyres' forces (wheel frame): the deflections' force, and below
@@ -355,14 +356,14 @@ PADDOCK_SIMD_INLINE Deriv derivative_body(const Model& m, const X& s) {
   {
     const D4 load = simd::load(fz);
     D4 fx4, fy4, mu;
-    tyre_lanes(p, m.tyres, simd::load(s.ux.data()) * m.inv_sigma_x,
-               slip_angle(m.tyres, simd::load(s.uy.data()) * m.inv_sigma_y), load, fx4, fy4, mu);
+    tyre_lanes(p, m.tyres, simd::load(s.ux.data()) * m.k->inv_sigma_x,
+               slip_angle(m.tyres, simd::load(s.uy.data()) * m.k->inv_sigma_y), load, fx4, fy4, mu);
     const D4 vx4 = simd::load(vcx);
     const D4 low = 1.0 - simd::abs(vx4) * (1.0 / kLowSpeed);
-    const D4 k = low * min_lanes(simd::splat(1.0), load * simd::load(m.inv_fz_static.data()));
-    const D4 fx_damped = clamp_lanes(fx4 + k * simd::load(m.c_x.data()) * simd::load(v_slip), -p.tyre_dx * mu,
+    const D4 k = low * min_lanes(simd::splat(1.0), load * simd::load(m.k->inv_fz_static.data()));
+    const D4 fx_damped = clamp_lanes(fx4 + k * simd::load(m.k->c_x.data()) * simd::load(v_slip), -p.tyre_dx * mu,
                                      p.tyre_dx * mu);
-    const D4 fy_damped = clamp_lanes(fy4 - k * simd::load(m.c_y.data()) * simd::load(vcy), -p.tyre_d * mu,
+    const D4 fy_damped = clamp_lanes(fy4 - k * simd::load(m.k->c_y.data()) * simd::load(vcy), -p.tyre_d * mu,
                                      p.tyre_d * mu);
     const auto slow = low > 0.0;
     simd::store(fx, simd::select(slow, fx_damped, fx4));
@@ -372,13 +373,13 @@ PADDOCK_SIMD_INLINE Deriv derivative_body(const Model& m, const X& s) {
   double fx_sum = 0.0, fy_sum = 0.0, mz = 0.0;
   for (std::size_t i = 0; i < 4; ++i) {
     // the deflections relax towards the slips
-    d.ux[i] = v_slip[i] - std::abs(vcx[i]) * s.ux[i] * m.inv_sigma_x;
-    d.uy[i] = vcy[i] - std::abs(vcx[i]) * s.uy[i] * m.inv_sigma_y;
+    d.ux[i] = v_slip[i] - std::abs(vcx[i]) * s.ux[i] * m.k->inv_sigma_x;
+    d.uy[i] = vcy[i] - std::abs(vcx[i]) * s.uy[i] * m.k->inv_sigma_y;
     // the wheel's spin
-    out.t_net[i] = t_drive[i] - fx[i] * m.radius;
-    out.t_fric[i] = s.brk * m.brake_torque[i] - regen[i] + m.rr_torque;
+    out.t_net[i] = t_drive[i] - fx[i] * m.k->radius;
+    out.t_fric[i] = s.brk * m.k->brake_torque[i] - regen[i] + m.k->rr_torque;
     d.w[i] = m.friction_sign[i] == 0.0 ? 0.0
-                                       : (out.t_net[i] - m.friction_sign[i] * out.t_fric[i]) * m.inv_inertia[i];
+                                       : (out.t_net[i] - m.friction_sign[i] * out.t_fric[i]) * m.k->inv_inertia[i];
     // the force on the chassis, body frame: the longitudinal part at the
     // contact point, the lateral part at the axle centre (where its slip was
     // taken, so that each part's power is the force times its slip velocity
@@ -387,12 +388,12 @@ PADDOCK_SIMD_INLINE Deriv derivative_body(const Model& m, const X& s) {
     const double fby = sn[i] * fx[i] + c[i] * fy[i];
     fx_sum += fbx;
     fy_sum += fby;
-    mz += m.x[i] * fby - m.y[i] * c[i] * fx[i];
+    mz += m.k->x[i] * fby - m.k->y[i] * c[i] * fx[i];
   }
 
-  d.vx = s.r * s.vy + (fx_sum - f_drag) * m.inv_m;
-  d.vy = -s.r * s.vx + fy_sum * m.inv_m;
-  d.r = mz * m.inv_iz;
+  d.vx = s.r * s.vy + (fx_sum - f_drag) * m.k->inv_m;
+  d.vy = -s.r * s.vx + fy_sum * m.k->inv_m;
+  d.r = mz * m.k->inv_iz;
 
   // the CG acceleration in the body frame, and the suspension's lagged copy of ax
   out.ax = d.vx - s.r * s.vy;
@@ -572,7 +573,7 @@ namespace {
 Model make_model(const Car& car, const VehicleState& s, const DriverInput& in, double steer_cmd, double dt) {
   const VehicleParams& p = car.params();
   Model m;
-  static_cast<CarConstants&>(m) = car.constants();
+  m.k = &car.constants();
   m.p = &p;
   m.tyres = car.tyres();
   const double yaw_moment = finite_or(in.yaw_moment, 0.0);
@@ -582,12 +583,12 @@ Model make_model(const Car& car, const VehicleState& s, const DriverInput& in, d
     // torque vectoring: the driven axles share the yaw moment as their drive
     // shares, each as a left/right force difference M / track: +-M r / track
     const double track = front ? p.track_front : p.track_rear;
-    m.tv_torque[i] = (m.y[i] > 0.0 ? -1.0 : 1.0) * 2.0 * m.drive_share[i] * yaw_moment * p.wheel_radius / track;
+    m.tv_torque[i] = (m.k->y[i] > 0.0 ? -1.0 : 1.0) * 2.0 * m.k->drive_share[i] * yaw_moment * p.wheel_radius / track;
     // traction control: each driven wheel's torque is cut linearly from the
     // slip ratio kappa* to (1 + kTractionBand) kappa*, sampled at the step's start
     m.traction[i] = 1.0;
-    if (p.traction_control_slip > 0.0 && m.drive_share[i] > 0.0) {
-      const double vbx = s.vx - s.r * m.y[i], vby = s.vy + s.r * m.x[i];
+    if (p.traction_control_slip > 0.0 && m.k->drive_share[i] > 0.0) {
+      const double vbx = s.vx - s.r * m.k->y[i], vby = s.vy + s.r * m.k->x[i];
       const double vcx = front ? cd * vbx + sd * vby : vbx;
       const double kappa = (s.omega[i] * p.wheel_radius - vcx) / std::max(std::abs(vcx), kTractionSpeedFloor);
       const double excess = (kappa - p.traction_control_slip) / (kTractionBand * p.traction_control_slip);
@@ -629,7 +630,7 @@ void decide_friction(Model& m, const X& x0, Deriv& k1) {
     double sgn = sign(x0.w[i]);
     if (sgn == 0.0) sgn = std::abs(k1.t_net[i]) <= k1.t_fric[i] ? 0.0 : sign(k1.t_net[i]);
     m.friction_sign[i] = sgn;
-    k1.d.w[i] = sgn == 0.0 ? 0.0 : (k1.t_net[i] - sgn * k1.t_fric[i]) * m.inv_inertia[i];
+    k1.d.w[i] = sgn == 0.0 ? 0.0 : (k1.t_net[i] - sgn * k1.t_fric[i]) * m.k->inv_inertia[i];
   }
 }
 
@@ -693,8 +694,8 @@ void step_with(DerivativeFn derivative, const Car& car, VehicleState& s, const D
   // stops growing at kSlipCap
   for (std::size_t i = 0; i < 4; ++i) {
     s.omega[i] = x1.w[i] * m.friction_sign[i] < 0.0 ? 0.0 : x1.w[i];
-    s.u_x[i] = std::clamp(x1.ux[i], -m.ux_cap, m.ux_cap);
-    s.u_y[i] = std::clamp(x1.uy[i], -m.uy_cap, m.uy_cap);
+    s.u_x[i] = std::clamp(x1.ux[i], -m.k->ux_cap, m.k->ux_cap);
+    s.u_y[i] = std::clamp(x1.uy[i], -m.k->uy_cap, m.k->uy_cap);
   }
 
   // mean accelerations and power over the step, with RK4's weights
