@@ -1,5 +1,6 @@
 #pragma once
 // plane geometry value types shared by every module: vectors, poses, angles.
+#include <algorithm>
 #include <cmath>
 
 namespace paddock {
@@ -29,6 +30,28 @@ inline constexpr double dot(Vec2 a, Vec2 b) { return a.x * b.x + a.y * b.y; }
 inline constexpr double cross(Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; }
 inline double norm(Vec2 v) { return std::hypot(v.x, v.y); }
 inline constexpr double squared_norm(Vec2 v) { return v.x * v.x + v.y * v.y; }
+
+// an axis-aligned box grown point by point (a point with a coordinate that is
+// not finite is left out); empty, near nothing, until a point is added. For
+// the candidates of a nearest-neighbour search over a small region: near()
+// takes the reach a hair wider (1e-9 relative) so that no point whose
+// computed distance is within the reach is left out by rounding
+struct Box {
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+
+  void add(Vec2 p) {
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) return;
+    x0 = std::min(x0, p.x);
+    y0 = std::min(y0, p.y);
+    x1 = std::max(x1, p.x);
+    y1 = std::max(y1, p.y);
+  }
+  // p within `reach` of the box along each axis
+  bool near(Vec2 p, double reach) const {
+    const double r = reach * (1.0 + 1e-9);
+    return p.x >= x0 - r && p.x <= x1 + r && p.y >= y0 - r && p.y <= y1 + r;
+  }
+};
 inline double distance(Vec2 a, Vec2 b) { return norm(a - b); }
 inline Vec2 unit_from_angle(double a) { return {std::cos(a), std::sin(a)}; }
 inline double angle_of(Vec2 v) { return std::atan2(v.y, v.x); }

@@ -39,23 +39,14 @@ int clear_trajectory(std::vector<Vec2>& points, const Trajectory& traj, const st
   // a pass over every cone would, the first of equals
   constexpr std::size_t kRun = 32;
   const double gate = params.clearance - tolerance;
-  const double reach_box = std::abs(gate) * (1.0 + 1e-9);
   std::vector<const Cone*> near;
   for (std::size_t first = 0; first < traj.points.size(); first += kRun) {
     const std::size_t last = std::min(traj.points.size(), first + kRun);
-    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-    for (std::size_t k = first; k < last; ++k) {
-      x0 = std::min(x0, traj.points[k].x);
-      y0 = std::min(y0, traj.points[k].y);
-      x1 = std::max(x1, traj.points[k].x);
-      y1 = std::max(y1, traj.points[k].y);
-    }
+    Box run;
+    for (std::size_t k = first; k < last; ++k) run.add(traj.points[k].position());
     near.clear();
-    for (const Cone& c : cones) {
-      const Vec2 q = c.position;
-      if (q.x >= x0 - reach_box && q.x <= x1 + reach_box && q.y >= y0 - reach_box && q.y <= y1 + reach_box)
-        near.push_back(&c);
-    }
+    for (const Cone& c : cones)
+      if (run.near(c.position, std::abs(gate))) near.push_back(&c);
     for (std::size_t k = first; k < last; ++k) {
       const Vec2 p = traj.points[k].position();
       const Cone* nearest = nullptr;

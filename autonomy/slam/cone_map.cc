@@ -16,20 +16,11 @@ void ConeMap::add(const std::vector<Cone>& detections) {
   // the mapped cones a detection can reach: those within the gate of the
   // frame's bounding box, in the map's order (a frame covers a small part of
   // the map; a cone this frame adds is taken at once, so never a candidate)
-  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (const Cone& d : detections) {
-    if (!std::isfinite(d.position.x) || !std::isfinite(d.position.y)) continue;
-    x0 = std::min(x0, d.position.x);
-    y0 = std::min(y0, d.position.y);
-    x1 = std::max(x1, d.position.x);
-    y1 = std::max(y1, d.position.y);
-  }
-  const double reach = gate * (1.0 + 1e-9);  // a hair wider than the gate: never one too few
+  Box frame;
+  for (const Cone& d : detections) frame.add(d.position);
   candidates_.clear();
-  for (std::size_t i = 0; i < cones_.size(); ++i) {
-    const Vec2 p = cones_[i].position;
-    if (p.x >= x0 - reach && p.x <= x1 + reach && p.y >= y0 - reach && p.y <= y1 + reach) candidates_.push_back(i);
-  }
+  for (std::size_t i = 0; i < cones_.size(); ++i)
+    if (frame.near(cones_[i].position, gate)) candidates_.push_back(i);
   // each mapped cone takes at most one detection of a frame (a frame sees a cone once)
   taken_.assign(candidates_.size(), 0);
   for (const Cone& d : detections) {

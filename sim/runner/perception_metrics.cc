@@ -45,20 +45,11 @@ void PerceptionMetrics::add(const hal::ConeDetections& perceived, const Pose2& b
   // the true cones within the radius of the frame's bounding box (a frame
   // sees a small part of the track), then the candidate pairs within the
   // radius, nearest first
-  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (const Vec2& p : seen) {
-    if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;
-    x0 = std::min(x0, p.x);
-    y0 = std::min(y0, p.y);
-    x1 = std::max(x1, p.x);
-    y1 = std::max(y1, p.y);
-  }
-  const double reach = match_radius_ * (1.0 + 1e-9);  // a hair wider: never one too few
+  Box frame;
+  for (const Vec2& p : seen) frame.add(p);
   std::vector<std::size_t> near;
-  for (std::size_t j = 0; j < truth.size(); ++j) {
-    const Vec2 t = truth[j].position;
-    if (t.x >= x0 - reach && t.x <= x1 + reach && t.y >= y0 - reach && t.y <= y1 + reach) near.push_back(j);
-  }
+  for (std::size_t j = 0; j < truth.size(); ++j)
+    if (frame.near(truth[j].position, match_radius_)) near.push_back(j);
   std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
   for (std::size_t i = 0; i < seen.size(); ++i) {
     if (!std::isfinite(seen[i].x) || !std::isfinite(seen[i].y)) continue;
