@@ -79,4 +79,13 @@ TrajectoryProjection project(const Trajectory& traj, Vec2 q, double s_hint, doub
   return out;
 }
 
+TrajectoryProjection project_near(const Trajectory& traj, Vec2 q, double s_hint, double window, double relocalize) {
+  TrajectoryProjection near = project(traj, q, s_hint, window);
+  if (std::abs(near.offset) > relocalize) {
+    const TrajectoryProjection all = project(traj, q, 0.0, 0.0);
+    if (std::abs(all.offset) < std::abs(near.offset)) near = all;
+  }
+  return near;
+}
+
 }  // namespace paddock

@@ -49,5 +49,9 @@ struct TrajectoryProjection {
 // the closest point, searched within +-window metres of arc length around
 // s_hint (a window <= 0 searches everything); the trajectory must not be empty
 TrajectoryProjection project(const Trajectory& traj, Vec2 q, double s_hint, double window);
+// a tracked point's projection: within the window around s_hint, unless that
+// one lies farther than `relocalize` from q and a search of everything finds
+// a nearer one
+TrajectoryProjection project_near(const Trajectory& traj, Vec2 q, double s_hint, double window, double relocalize);
 
 }  // namespace paddock

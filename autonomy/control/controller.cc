@@ -95,11 +95,7 @@ ControlOutput Controller::update(const ControlInput& in) {
   const bool hint_valid = have_hint_ && same_trajectory(traj);
   TrajectoryProjection base;
   if (hint_valid) {
-    base = project(traj, rear, s_hint_ + v * in.dt, params_.projection_window);
-    if (std::abs(base.offset) > params_.relocalize_distance) {
-      const TrajectoryProjection all = project(traj, rear, 0.0, 0.0);
-      if (std::abs(all.offset) < std::abs(base.offset)) base = all;
-    }
+    base = project_near(traj, rear, s_hint_ + v * in.dt, params_.projection_window, params_.relocalize_distance);
   } else {
     base = project(traj, rear, 0.0, 0.0);
   }

@@ -375,13 +375,10 @@ double Stack::finish_approach_cap(Vec2 base) const {
   // the car's place on the path: around last cycle's on the same trajectory
   // (as the controller's), a full search the first time or when that misses
   const control::ControlParams& cp = params_.control;
-  TrajectoryProjection car;
-  if (car_projected_version_ == trajectory_version_) {
-    car = project(trajectory_, base, car_s_, cp.projection_window);
-    if (std::abs(car.offset) > cp.relocalize_distance) car = project(trajectory_, base, 0.0, 0.0);
-  } else {
-    car = project(trajectory_, base, 0.0, 0.0);
-  }
+  const TrajectoryProjection car =
+      car_projected_version_ == trajectory_version_
+          ? project_near(trajectory_, base, car_s_, cp.projection_window, cp.relocalize_distance)
+          : project(trajectory_, base, 0.0, 0.0);
   car_s_ = car.s;
   car_projected_version_ = trajectory_version_;
   // braking at stop_decel_max (less in turns) to the finish speed that stops
