@@ -2,25 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 
 namespace paddock::vehicle {
 
 namespace {
 
 constexpr int kNodes = EvenTable::kDegree + 1;
-
-std::uint64_t bits_of(double v) {
-  std::uint64_t b;
-  std::memcpy(&b, &v, sizeof b);
-  return b;
-}
-
-double from_bits(std::uint64_t b) {
-  double v;
-  std::memcpy(&v, &b, sizeof v);
-  return v;
-}
 
 // a cell's centre and half width
 struct Cell {
@@ -86,20 +73,7 @@ double EvenTable::build(const std::function<long double(long double)>& f) {
   return worst;
 }
 
-double EvenTable::at(double s) const {
-  const bool inside = s >= 0.0 && s < kMax;
-  const double v = inside ? s : 0.0;
-  const std::uint64_t bits = bits_of(v);
-  const bool first = v < kFirst;
-  const std::int64_t cell = first ? 0 : static_cast<std::int64_t>(bits >> 48) - (kFirstTop - 1);
-  const double centre = first ? 0.5 * kFirst : from_bits((bits & static_cast<std::uint64_t>(kTopMask)) | kHalfBit);
-  const double d = v - centre;
-  const std::array<double, kDegree + 1>& c = c_[static_cast<std::size_t>(cell)];
-  const double d2 = d * d;
-  const double d4 = d2 * d2;
-  const double p01 = c[0] + c[1] * d, p23 = c[2] + c[3] * d, p45 = c[4] + c[5] * d, p67 = c[6] + c[7] * d;
-  return (p01 + p23 * d2) + (p45 + p67 * d2) * d4;
-}
+double EvenTable::at(double s) const { return (*this)(simd::splat(s))[0]; }
 
 TyreTables::TyreTables(double c, double e) {
   const long double cl = c, el = e;

@@ -66,7 +66,7 @@ class EvenTable {
     return (p01 + p23 * d2) + (p45 + p67 * d2) * d4;
   }
 
-  // the same for one s, as the lanes compute it (for the build's check)
+  // the same for one s (the lanes' computation: for the build's check)
   double at(double s) const;
 
  private:
