@@ -40,8 +40,19 @@ Pose2 PoseHistory::at(TimeNs t) const {
   if (poses_.empty()) return {};
   if (t <= poses_.front().first) return poses_.front().second;
   if (t >= poses_.back().first) return poses_.back().second;
-  const auto it = std::lower_bound(poses_.begin(), poses_.end(), t,
-                                   [](const std::pair<TimeNs, Pose2>& p, TimeNs v) { return p.first < v; });
+  // the first pose at or after t (lower_bound's). The poses come a physics
+  // step apart, so the one where t falls at a steady spacing is nearly
+  // always it: that guess is checked, and the search runs only when it misses
+  const std::size_t n = poses_.size();
+  // (t - 1: a t on a pose is that pose's)
+  const TimeNs first = poses_.front().first, span = poses_.back().first - first;
+  const double steps = static_cast<double>(t - 1 - first) / static_cast<double>(span) * static_cast<double>(n - 1);
+  const std::size_t g = std::min(n - 1, 1 + static_cast<std::size_t>(steps));
+  auto it = poses_.begin() + static_cast<std::ptrdiff_t>(g);
+  if (!(it->first >= t && (it - 1)->first < t)) {
+    it = std::lower_bound(poses_.begin(), poses_.end(), t,
+                          [](const std::pair<TimeNs, Pose2>& p, TimeNs v) { return p.first < v; });
+  }
   const auto& [t1, p1] = *it;
   const auto& [t0, p0] = *(it - 1);
   const double u = static_cast<double>(t - t0) / static_cast<double>(t1 - t0);
@@ -103,8 +114,9 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
     frame_painted_ = pixels_;
     detection = detector_->detect(frame, annotation_);
   };
-  std::vector<sensors::LidarPoint> raw;
-  const auto cast = [&] { raw = lidar_.scan(*world_, [&poses](TimeNs at) { return poses.at(at); }, start); };
+  // (into the buffer of the rotations before: no allocation)
+  std::vector<sensors::LidarPoint>& raw = raw_;
+  const auto cast = [&] { lidar_.scan(*world_, [&poses](TimeNs at) { return poses.at(at); }, start, raw); };
   bool cast_done = false;
   if (render && lidar_on && workers_.threads() > 1) {
     const StageScope scope(profile_, Stage::Camera);  // what the camera takes beyond the cast
@@ -137,8 +149,8 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
   if (!cast_done) cast();
   faults.filter_lidar(t, raw);
   truth_.resize(raw.size());
-  for (std::size_t i = 0; i < raw.size(); ++i) truth_[i] = raw[i].cone;
   if (const WireLink* wire = hal.wire(); wire != nullptr && wire->has_lidar()) {
+    for (std::size_t i = 0; i < raw.size(); ++i) truth_[i] = raw[i].cone;
     // the sensor's packets, in the order it sends them (the car's decoder
     // gives the points back in the scan's order: column by column, rings up)
     column_time_.resize(static_cast<std::size_t>(lidar_.params().columns));
@@ -151,10 +163,13 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
   hal::LidarScan scan;
   scan.stamp = start;
   scan.end = scan_end(now);
-  scan.points.resize(raw.size());
+  // the points and their truth in one pass (each point written once: no
+  // value-initialised vector overwritten after)
+  scan.points.reserve(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) {
     const sensors::LidarPoint& p = raw[i];
-    scan.points[i] = hal::LidarPoint{p.x, p.y, p.z, p.intensity, p.ring, p.t};
+    truth_[i] = p.cone;
+    scan.points.push_back(hal::LidarPoint{p.x, p.y, p.z, p.intensity, p.ring, p.t});
   }
   hal.post(std::move(scan));
   return truth_;

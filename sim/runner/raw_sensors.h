@@ -119,6 +119,7 @@ class RawSensors {
   std::vector<Cone> scene_cones_;
   std::vector<bool> scene_knocked_;
   std::vector<std::int32_t> truth_;
+  std::vector<sensors::LidarPoint> raw_;  // the last rotation's scan (its buffer reused)
   // transport = wire: the rotation counter (the packets' frame_id), the
   // columns' times, the packets (kept to save their allocations)
   std::uint16_t frame_id_ = 0;

@@ -882,6 +882,13 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
                                     const std::function<Pose2(TimeNs)>& base_pose_at,
                                     TimeNs start, LidarCast cast) {
   std::vector<LidarPoint> out;
+  scan(world, base_pose_at, start, out, cast);
+  return out;
+}
+
+void Lidar::scan(const LidarWorld& world, const std::function<Pose2(TimeNs)>& base_pose_at, TimeNs start,
+                 std::vector<LidarPoint>& out, LidarCast cast) {
+  out.clear();
   const int nch = params_.channels, ncol = params_.columns;
   const auto nchu = static_cast<std::size_t>(nch);
   const float tfar = static_cast<float>(params_.range_max + 6.0 * params_.range_noise + 0.01);
@@ -1113,7 +1120,6 @@ std::vector<LidarPoint> Lidar::scan(const LidarWorld& world,
     }
     out.insert(out.end(), b.points.data(), dst);
   }
-  return out;
 }
 
 }  // namespace paddock::sensors

@@ -354,6 +354,10 @@ class Lidar {
   std::vector<LidarPoint> scan(const LidarWorld& world,
                                const std::function<Pose2(TimeNs)>& base_pose_at, TimeNs start,
                                LidarCast cast = LidarCast::Exploit);
+  // the same scan into `out` (its contents replaced, its capacity kept: a
+  // caller that scans every rotation into one buffer allocates nothing)
+  void scan(const LidarWorld& world, const std::function<Pose2(TimeNs)>& base_pose_at, TimeNs start,
+            std::vector<LidarPoint>& out, LidarCast cast = LidarCast::Exploit);
 
   const LidarParams& params() const { return params_; }
   TimeNs period_ns() const { return from_seconds(1.0 / params_.rate); }
