@@ -224,6 +224,27 @@ void Stack::learn_gates(const Pose2& pose, TimeNs now, double speed) {
   }
 }
 
+bool Stack::lap_still_holds(const hal::StateEstimate& st, const std::vector<Cone>& cones) const {
+  const MissionParams& mp = params_.mission;
+  const double tolerance = mp.lap_replan_tolerance;
+  if (!(tolerance > 0.0) || !last_plan_.ok() || !last_plan_.closed || !trajectory_.closed || !pending_lap_.empty()) {
+    return false;
+  }
+  // near the start, where the lap is taken (plan() below), it is planned anew
+  if (!(mp.loop_closure_radius > 0.0) || !start_position_ ||
+      !(distance(st.pose.position(), *start_position_) >= mp.loop_closure_radius)) {
+    return false;
+  }
+  if (cones.size() != last_plan_cones_.size()) return false;
+  for (std::size_t i = 0; i < cones.size(); ++i) {
+    if (cones[i].color != last_plan_cones_[i].color ||
+        !(distance(cones[i].position, last_plan_cones_[i].position) <= tolerance)) {
+      return false;
+    }
+  }
+  return true;
+}
+
 void Stack::plan(const hal::StateEstimate& st) {
   map_news_ = false;
   const std::vector<Cone> cones = cone_map_.cones();
@@ -250,6 +271,14 @@ void Stack::plan(const hal::StateEstimate& st) {
     }
     set_trajectory(std::move(sp.trajectory));
     telemetry_.lap_locked = true;
+    return;
+  }
+
+  // a closed lap the car drives already is kept while the map is the one it
+  // was planned on (lap_replan_tolerance): planned again, it would be the
+  // same ring
+  if (lap_still_holds(st, cones)) {
+    if (spec_.gates.empty()) learn_gates(st.pose, st.stamp, st.vx);
     return;
   }
 

@@ -85,6 +85,14 @@ struct MissionParams {
   // map still being explored
   double loop_closure_distance = 100.0;
   double loop_closure_radius = 15.0;
+  // a closed lap the car drives (before it is taken for good at the start)
+  // is planned again only when the map is no longer the one it was planned
+  // on: a cone added, lost or of another colour, or one moved by more than
+  // this. Planned again on the same map it is the same ring of midpoints
+  // (its spline begun elsewhere on it); planned every frame, the whole
+  // lap's search and profile were half a run's planning time (FSG 2023 on
+  // the true cones), spent in the first lap's last 40 m
+  double lap_replan_tolerance = 0.05;
   // so the handover does not jerk the car sideways
   double lap_switch_offset = 0.1;
   // ... and heads within this of the car's heading: a racing line crosses
@@ -118,6 +126,8 @@ struct MissionParams {
     v(PADDOCK_PARAM(loop_closure_distance), {"m", params::in(0.0, 10000.0), "driving before a closed centreline is the lap"});
     v(PADDOCK_PARAM(loop_closure_radius), {"m", params::in(0.0, 10000.0),
                                            "the car must be this close to its start for the lap to be taken (0: anywhere)"});
+    v(PADDOCK_PARAM(lap_replan_tolerance), {"m", params::in(0.0, 10.0),
+                                            "a closed lap is planned again when a mapped cone moved more than this since it was planned, or cones came or went (0: every frame)"});
     v(PADDOCK_PARAM(lap_switch_offset), {"m", params::in(0.0, 10.0), "the closed lap takes over where the car is this close to it"});
     v(PADDOCK_PARAM(lap_switch_heading), {"rad", params::in(0.0, 3.2), "... and where it heads within this of the car's heading"});
     v(PADDOCK_PARAM(gate_min_observations), {"", params::at_least(1), "a timekeeping gate is learned from big orange cones seen this often ..."});
@@ -257,6 +267,8 @@ class Stack {
   std::optional<Pose2> pose_at(TimeNs t) const;
   // planner = delaunay: a new plan from the cone map when the map has news
   void plan(const hal::StateEstimate& st);
+  // the closed lap the car drives still stands on this map (MissionParams::lap_replan_tolerance)
+  bool lap_still_holds(const hal::StateEstimate& st, const std::vector<Cone>& cones) const;
   void learn_gates(const Pose2& pose, TimeNs now, double speed);
   // on the last lap: the fastest speed from which the car can still brake to
   // the finish speed that stops within the stop distance (infinite otherwise)
@@ -329,7 +341,7 @@ class Stack {
   hal::ConeDetections last_detections_;
   long detection_frames_ = 0;
   planning::PlanResult last_plan_;
-  std::vector<Cone> last_plan_cones_;
+  std::vector<Cone> last_plan_cones_;       // the map last_plan_ was planned on
   Trajectory pending_lap_;                  // the closed lap, waiting for a smooth handover
   std::vector<double> lap_speed_;           // the lap's own speeds while its first metres ramp up to them
   std::optional<double> catch_up_until_;    // driven_ where the ramp meets the lap's speeds (m)

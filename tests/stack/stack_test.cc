@@ -433,6 +433,96 @@ TEST(Stack, AGateSeenOnlyAfterTheCarCrossedItCounts) {
   EXPECT_EQ(s.gates().size(), 2u);
 }
 
+// a trackdrive on a ring of cones (radius 40 m, 3.5 m wide, a cone every
+// ~4 m a side) seen whole and exactly from the start, the Delaunay planner on
+// the true state; a kinematic bicycle drives it. Returns the planning cycles
+// run while the car drove from `from` to `to` metres (the closed lap is the
+// path from 100 m, loop_closure_distance; it is taken at the start, 251 m
+// round, within loop_closure_radius 15 m), and whether the lap was taken.
+// extra_at: from this distance on, one more cone (outside the ring) is seen
+struct RingRun {
+  int plans_between = 0;
+  bool lap_locked = false;
+  double driven = 0.0;
+};
+RingRun drive_ring(double tolerance, double from, double to, double extra_at = -1.0) {
+  StackParams p;
+  p.autonomy.planner = PlannerMode::Delaunay;
+  p.as.ready_wait = 0.0;
+  p.mission.lap_replan_tolerance = tolerance;
+  MissionSpec m;
+  m.mission = Mission::Trackdrive;
+  m.gates = {Segment{{0.0, 3.0}, {0.0, -3.0}}};
+  m.finish_crossings = 100;  // no stop
+  Stack s(p, m);
+  ScriptedHal hal;
+  // counter-clockwise round (0, 40) from (0, 0): blue inside, yellow outside
+  const double R = 40.0;
+  std::vector<Cone> cones;
+  for (int i = 0; i < 64; ++i) {
+    const double a = -kPi / 2 + 2 * kPi * i / 64;
+    cones.push_back({Vec2{0.0, R} + unit_from_angle(a) * (R - 1.75), ConeColor::Blue});
+    cones.push_back({Vec2{0.0, R} + unit_from_angle(a) * (R + 1.75), ConeColor::Yellow});
+  }
+  const Cone extra{Vec2{0.0, R} + unit_from_angle(kPi / 2) * (R + 8.0), ConeColor::SmallOrange};
+  double x = -2.0, y = 0.0, yaw = 0.0, v = 0.0, delta = 0.0, driven = 0.0;
+  int plans_from = -1, plans_to = -1;
+  const double L = p.vehicle.wheelbase;
+  for (int k = 0; k < 100 * 80 && plans_to < 0; ++k) {
+    const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
+    hal.inbox.push_back(state_at(t, {x, y}, yaw, v));
+    if (k % 10 == 0) {
+      hal::ConeDetections d;
+      d.stamp = t;
+      const Pose2 pose{x, y, yaw};
+      for (const Cone& c : cones) d.cones.push_back({pose.inverse_transform(c.position), c.color, true});
+      if (extra_at >= 0.0 && driven >= extra_at) d.cones.push_back({pose.inverse_transform(extra.position), extra.color, true});
+      hal.inbox.push_back(d);
+    }
+    if (k == 100) hal.inbox.push_back(hal::ResSignal{t, true, false});
+    s.tick(t, hal);
+    if (plans_from < 0 && driven >= from) plans_from = s.telemetry().plans;
+    if (plans_to < 0 && driven >= to) plans_to = s.telemetry().plans;
+    const auto& c = hal.sent.back();
+    delta = c.steering_angle;
+    const double a = 8.0 * c.throttle - 10.0 * c.brake;
+    for (int i = 0; i < 10; ++i) {
+      const double dt = 1e-3;
+      x += v * std::cos(yaw) * dt;
+      y += v * std::sin(yaw) * dt;
+      yaw += v * std::tan(delta) / L * dt;
+      driven += v * dt;
+      v = std::max(0.0, v + a * dt);
+    }
+  }
+  return {plans_to - plans_from, s.telemetry().lap_locked, driven};
+}
+
+// the closed lap is not planned again on the map it was planned on (the lap
+// before the start, 120 to 220 m): planned again it would be the same lap
+TEST(Stack, AClosedLapIsKeptWhileTheMapStaysAsPlanned) {
+  const RingRun held = drive_ring(0.05, 120.0, 220.0);
+  const RingRun every = drive_ring(0.0, 120.0, 220.0);
+  ASSERT_GE(held.driven, 220.0);
+  ASSERT_GE(every.driven, 220.0);
+  // 100 m at the planned speeds: many frames, every one planned without the hold
+  EXPECT_GT(every.plans_between, 40) << "the map has news every frame";
+  EXPECT_EQ(held.plans_between, 0);
+  // and the lap is still taken at the start
+  const RingRun lap = drive_ring(0.05, 120.0, 260.0);
+  EXPECT_TRUE(lap.lap_locked);
+  EXPECT_GT(lap.plans_between, 0) << "planned again near the start, where the lap is taken";
+}
+
+// a map that changes (a cone more, seen from 150 m on) is planned again once,
+// then held again
+TEST(Stack, AClosedLapIsPlannedAgainWhenTheMapChanges) {
+  const RingRun run = drive_ring(0.05, 120.0, 220.0, 150.0);
+  ASSERT_GE(run.driven, 220.0);
+  EXPECT_GE(run.plans_between, 1);
+  EXPECT_LE(run.plans_between, 2);  // (the new cone's first sightings may move it a little)
+}
+
 TEST(StackParams, EveryParameterHasOnePathAndWhatTheRunnerFillsHasNone) {
   const std::vector<std::string> paths = params::field_paths(StackParams{});
   std::vector<std::string> sorted = paths;
