@@ -74,6 +74,26 @@ hal::StateEstimate state_at(TimeNs t, Vec2 p, double yaw, double v) {
   return hal::StateEstimate{t, Pose2{p.x, p.y, yaw}, v, 0.0, 0.0};
 }
 
+// a kinematic bicycle at the rear axle (wheelbase L) driven by a command for
+// one 10 ms control cycle in 1 ms steps, the pedals as accelerations (8 m/s^2
+// full throttle, 10 full brake); returns the distance driven
+struct Bicycle {
+  double x = -2.0, y = 0.0, yaw = 0.0, v = 0.0;
+  double cycle(const hal::ActuatorCommand& c, double L) {
+    const double a = 8.0 * c.throttle - 10.0 * c.brake;
+    double driven = 0.0;
+    for (int i = 0; i < 10; ++i) {
+      const double dt = 1e-3;
+      x += v * std::cos(yaw) * dt;
+      y += v * std::sin(yaw) * dt;
+      yaw += v * std::tan(c.steering_angle) / L * dt;
+      driven += v * dt;
+      v = std::max(0.0, v + a * dt);
+    }
+    return driven;
+  }
+};
+
 TEST(Stack, WaitsInReadyWithBrakesOnUntilGo) {
   Stack s(oracle_params(), circle_mission(2));
   ScriptedHal hal;
@@ -141,29 +161,20 @@ TEST(Stack, CountsFinishCrossingsThenStopsAndFinishes) {
   const StackParams p = oracle_params();
   Stack s(p, circle_mission(3));  // start line, then two laps
   ScriptedHal hal;
-  double x = -2.0, y = 0.0, yaw = 0.0, v = 0.0, delta = 0.0;
+  Bicycle car;
   const double L = p.vehicle.wheelbase;
   int stop_crossing_cycle = -1;
   double dist_after_stop_start = 0.0;
   for (int k = 0; k < 100 * 120; ++k) {
     const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
-    hal.inbox.push_back(state_at(t, {x, y}, yaw, v));
+    hal.inbox.push_back(state_at(t, {car.x, car.y}, car.yaw, car.v));
     if (k == 10) hal.inbox.push_back(hal::ResSignal{t, true, false});
     s.tick(t, hal);
     const auto& c = hal.sent.back();
     if (c.as_state == hal::AsState::Finished) break;
     if (s.telemetry().stopping && stop_crossing_cycle < 0) stop_crossing_cycle = k;
-    // a kinematic bicycle at the rear axle, 10 ms steps; the pedals as accelerations
-    delta = c.steering_angle;
-    const double a = 8.0 * c.throttle - 10.0 * c.brake;
-    for (int i = 0; i < 10; ++i) {
-      const double dt = 1e-3;
-      x += v * std::cos(yaw) * dt;
-      y += v * std::sin(yaw) * dt;
-      yaw += v * std::tan(delta) / L * dt;
-      if (stop_crossing_cycle >= 0) dist_after_stop_start += v * dt;
-      v = std::max(0.0, v + a * dt);
-    }
+    const double d = car.cycle(c, L);
+    if (stop_crossing_cycle >= 0) dist_after_stop_start += d;
   }
   EXPECT_EQ(s.telemetry().finish_crossings, 3);
   EXPECT_TRUE(s.telemetry().stopping);
@@ -465,16 +476,17 @@ RingRun drive_ring(double tolerance, double from, double to, double extra_at = -
     cones.push_back({Vec2{0.0, R} + unit_from_angle(a) * (R + 1.75), ConeColor::Yellow});
   }
   const Cone extra{Vec2{0.0, R} + unit_from_angle(kPi / 2) * (R + 8.0), ConeColor::SmallOrange};
-  double x = -2.0, y = 0.0, yaw = 0.0, v = 0.0, delta = 0.0, driven = 0.0;
+  Bicycle car;
+  double driven = 0.0;
   int plans_from = -1, plans_to = -1;
   const double L = p.vehicle.wheelbase;
   for (int k = 0; k < 100 * 80 && plans_to < 0; ++k) {
     const TimeNs t = static_cast<TimeNs>(k) * 10'000'000;
-    hal.inbox.push_back(state_at(t, {x, y}, yaw, v));
+    hal.inbox.push_back(state_at(t, {car.x, car.y}, car.yaw, car.v));
     if (k % 10 == 0) {
       hal::ConeDetections d;
       d.stamp = t;
-      const Pose2 pose{x, y, yaw};
+      const Pose2 pose{car.x, car.y, car.yaw};
       for (const Cone& c : cones) d.cones.push_back({pose.inverse_transform(c.position), c.color, true});
       if (extra_at >= 0.0 && driven >= extra_at) d.cones.push_back({pose.inverse_transform(extra.position), extra.color, true});
       hal.inbox.push_back(d);
@@ -483,17 +495,7 @@ RingRun drive_ring(double tolerance, double from, double to, double extra_at = -
     s.tick(t, hal);
     if (plans_from < 0 && driven >= from) plans_from = s.telemetry().plans;
     if (plans_to < 0 && driven >= to) plans_to = s.telemetry().plans;
-    const auto& c = hal.sent.back();
-    delta = c.steering_angle;
-    const double a = 8.0 * c.throttle - 10.0 * c.brake;
-    for (int i = 0; i < 10; ++i) {
-      const double dt = 1e-3;
-      x += v * std::cos(yaw) * dt;
-      y += v * std::sin(yaw) * dt;
-      yaw += v * std::tan(delta) / L * dt;
-      driven += v * dt;
-      v = std::max(0.0, v + a * dt);
-    }
+    driven += car.cycle(hal.sent.back(), L);
   }
   return {plans_to - plans_from, s.telemetry().lap_locked, driven};
 }
