@@ -509,7 +509,7 @@ class Search {
     // the prediction: the heading turned as much again as over the last two
     // steps on average (the midpoints zig-zag), at this candidate's distance
     const Vec2 predicted = s.p + s.pred_dir * l;
-    t.prediction = bell(std::sqrt(squared_norm(e.mid - predicted)), p_.prediction_sigma);
+    t.prediction = bell(plain_norm(e.mid - predicted), p_.prediction_sigma);
     t.crossing = st->crossing;
     out.edge = c;
     out.step = step;

@@ -142,19 +142,14 @@ struct SplineBuilder {
   static double partial_length(const CubicSpline2D& s, std::size_t i, double t);
 };
 
-// |r'(t)|: the speed of a segment's parameter, a modest number (the fit
-// parameterises by chord length), so sqrt(x^2 + y^2) needs none of hypot's
-// care against overflow, and costs a fraction of it
-namespace {
-double speed_of(Vec2 d) { return std::sqrt(squared_norm(d)); }
-}  // namespace
-
+// (|r'(t)|, the speed of a segment's parameter, is a modest number: the fit
+// parameterises by chord length, so plain_norm)
 double SplineBuilder::partial_length(const CubicSpline2D& s, std::size_t i, double t) {
   const double half = 0.5 * t;
   double sum = 0.0;
   for (std::size_t k = 0; k < kGaussX.size(); ++k) {
     for (const double sign : {-1.0, 1.0}) {
-      sum += kGaussW[k] * speed_of(eval_poly(s.px_[i], s.py_[i], half * (1.0 + sign * kGaussX[k]), 1));
+      sum += kGaussW[k] * plain_norm(eval_poly(s.px_[i], s.py_[i], half * (1.0 + sign * kGaussX[k]), 1));
     }
   }
   return half * sum;
@@ -309,7 +304,7 @@ std::optional<double> CubicSpline2D::param_at_arc_length(double s) const {
     const double f = SplineBuilder::partial_length(*this, i, t) - target;
     if (std::abs(f) < 1e-12) break;
     if (f > 0.0) hi = t; else lo = t;
-    const double d = speed_of(eval_poly(px_[i], py_[i], t, 1));
+    const double d = plain_norm(eval_poly(px_[i], py_[i], t, 1));
     double next = d > 0.0 ? t - f / d : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     if (std::abs(next - t) < 1e-14 * (1.0 + h)) {

@@ -149,8 +149,8 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
   if (!cast_done) cast();
   faults.filter_lidar(t, raw);
   truth_.resize(raw.size());
+  for (std::size_t i = 0; i < raw.size(); ++i) truth_[i] = raw[i].cone;
   if (const WireLink* wire = hal.wire(); wire != nullptr && wire->has_lidar()) {
-    for (std::size_t i = 0; i < raw.size(); ++i) truth_[i] = raw[i].cone;
     // the sensor's packets, in the order it sends them (the car's decoder
     // gives the points back in the scan's order: column by column, rings up)
     column_time_.resize(static_cast<std::size_t>(lidar_.params().columns));
@@ -163,13 +163,10 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
   hal::LidarScan scan;
   scan.stamp = start;
   scan.end = scan_end(now);
-  // the points and their truth in one pass (each point written once: no
-  // value-initialised vector overwritten after)
-  scan.points.reserve(raw.size());
+  scan.points.resize(raw.size());
   for (std::size_t i = 0; i < raw.size(); ++i) {
     const sensors::LidarPoint& p = raw[i];
-    truth_[i] = p.cone;
-    scan.points.push_back(hal::LidarPoint{p.x, p.y, p.z, p.intensity, p.ring, p.t});
+    scan.points[i] = hal::LidarPoint{p.x, p.y, p.z, p.intensity, p.ring, p.t};
   }
   hal.post(std::move(scan));
   return truth_;

@@ -543,9 +543,8 @@ void ConeWorld::step(const Pose2& car_pose, double car_vx_world, double car_vy_w
                                          car_pose.yaw - yaw_rate * dt};
   const double dyaw = wrap_angle(car_pose.yaw - from.yaw);
   // no footprint point moves farther than this during the step
-  // (a step's few cm: sqrt(x^2 + y^2) needs none of hypot's care, at a fraction of its cost)
-  const Vec2 moved{car_pose.x - from.x, car_pose.y - from.y};
-  const double motion = std::sqrt(squared_norm(moved)) + std::abs(dyaw) * w.car_reach;
+  // (a step's few cm: plain_norm)
+  const double motion = plain_norm(Vec2{car_pose.x - from.x, car_pose.y - from.y}) + std::abs(dyaw) * w.car_reach;
   w.pose = car_pose;
   w.have_pose = true;
 
