@@ -57,7 +57,12 @@ struct SimModel {
   // perception's latency more
   TimeNs pose_history_span = 0;
   std::size_t visible_scans = 4;  // the scans' cones hit kept for the perception metrics
+  // the log samples of a run that lasts until its event's timeouts (at most
+  // kMaxReservedSamples): the per-sample records reserve this much, so that
+  // they never move while they grow (pages are only touched as rows come)
+  std::size_t log_samples = 0;
 };
+inline constexpr std::size_t kMaxReservedSamples = std::size_t{1} << 20;
 
 // compiles the model of a scenario on its track; the scenario was validated by
 // load_scenario, so this cannot fail

@@ -44,6 +44,7 @@ PerceptionSnapshot take_snapshot(const stack::PerceptionStage& p, const hal::Cam
 
 void LogRecorder::observe(const SimModel& model, SimState& s) {
   if (!s.sampled) return;
+  if (rows_.empty()) rows_.reserve(model.log_samples);
   const Pose2 base = vehicle::base_pose(model.scenario.vehicle, s.car);
   const Vec2 v = vehicle::base_velocity(model.scenario.vehicle, s.car);
   const control::Diagnostics& c = s.stack.telemetry().control;
@@ -116,8 +117,9 @@ void SnapshotRecorder::observe(const SimModel& model, SimState& s) {
   }
 }
 
-void SlamScorer::observe(const SimModel&, SimState& s) {
+void SlamScorer::observe(const SimModel& model, SimState& s) {
   if (!s.sampled || !s.stack.estimate()) return;
+  if (series_.empty()) series_.reserve(model.log_samples);
   const hal::StateEstimate& e = *s.stack.estimate();
   const Pose2 truth = s.true_poses.at(e.stamp);
   const double d = distance(e.pose.position(), truth.position());
@@ -141,16 +143,17 @@ double percentile(std::vector<double> v, double q) {
 }
 }  // namespace
 
-SlamMetrics SlamScorer::metrics(const SimModel& model, const SimState& state, const std::vector<events::Lap>& laps) const {
+SlamMetrics SlamScorer::metrics(const SimModel& model, const SimState& state, const std::vector<events::Lap>& laps) {
   SlamMetrics m;
   m.samples = n_;
-  m.series = series_;
+  m.series = std::move(series_);
+  const std::vector<SlamSample>& series = m.series;
   m.map = map_metrics(state.stack.cone_map().cones(), model.cones, path_);
   for (const events::Lap& lap : laps) {
     SlamLap l;
     double sum2 = 0.0;
     long n = 0;
-    for (const SlamSample& x : series_) {
+    for (const SlamSample& x : series) {
       if (x.t < lap.start || x.t >= lap.start + lap.time) continue;
       sum2 += x.error * x.error;
       l.ate_max = std::max(l.ate_max, x.error);
@@ -184,9 +187,9 @@ SlamMetrics SlamScorer::metrics(const SimModel& model, const SimState& state, co
   m.heading_rms = std::sqrt(heading2_ / static_cast<double>(n_));
   m.ate_max = max_;
   std::vector<Pose2> truth, estimate;
-  truth.reserve(series_.size());
-  estimate.reserve(series_.size());
-  for (const SlamSample& x : series_) {
+  truth.reserve(series.size());
+  estimate.reserve(series.size());
+  for (const SlamSample& x : series) {
     truth.push_back(x.truth);
     estimate.push_back(x.estimate);
   }

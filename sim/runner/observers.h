@@ -133,8 +133,9 @@ struct SlamMetrics {
 class SlamScorer final : public Observer {
  public:
   void observe(const SimModel& model, SimState& state) override;
-  // the map and the localisation's cost at the end of the run; per lap from the event's laps
-  SlamMetrics metrics(const SimModel& model, const SimState& state, const std::vector<events::Lap>& laps) const;
+  // the map and the localisation's cost at the end of the run; per lap from
+  // the event's laps. The series moves into the metrics: call it once
+  SlamMetrics metrics(const SimModel& model, const SimState& state, const std::vector<events::Lap>& laps);
 
  private:
   double sum2_ = 0.0, heading2_ = 0.0, max_ = 0.0;
