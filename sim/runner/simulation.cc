@@ -13,6 +13,15 @@
 namespace paddock::runner {
 namespace {
 
+// whether a periodic part falls due at this instant (k % every == 0 without a
+// division): run_due meets each instant once, from k = 0, and asks each part
+// once there
+inline bool falls_due(long& left, long every) {
+  if (--left > 0) return false;
+  left = every;
+  return true;
+}
+
 // the cone sensor's frame of the cones as they stand now, delivered after its latency
 void measure_cones(SimState& s, const Pose2& base) {
   for (int i = 0; i < s.cones.cone_count(); ++i) {
@@ -56,7 +65,7 @@ void post_can(SimState& s, hal::SensorMessage m) {
 // the wheel speeds, the steering angle
 void measure_odometry(const SimModel& model, SimState& s, const Pose2& base) {
   const vehicle::VehicleParams& car = model.scenario.vehicle;
-  if (s.k % model.every.imu == 0) {
+  if (falls_due(s.due_in.imu, model.every.imu)) {
     const double ax_base = s.car.ax + s.car.r * s.car.r * car.lr;
     const double ay_base = s.car.ay - s.car.yaw_accel * car.lr;
     const double az = imu_vertical_accel(model, s, base, ax_base, ay_base);
@@ -65,13 +74,13 @@ void measure_odometry(const SimModel& model, SimState& s, const Pose2& base) {
     s.faults.apply(s.t, s.last_imu, static_cast<double>(model.every.imu) * model.dt);
     post_can(s, s.last_imu);
   }
-  if (s.k % model.every.wheel_speeds == 0) {
+  if (falls_due(s.due_in.wheel_speeds, model.every.wheel_speeds)) {
     const sensors::WheelSpeedSample m = s.wheel_speeds.measure(vehicle::wheel_speeds(car, s.car), s.now);
     hal::WheelSpeeds w{m.stamp, m.omega};
     s.faults.apply(s.t, w);
     post_can(s, std::move(w));
   }
-  if (s.k % model.every.steering == 0) {
+  if (falls_due(s.due_in.steering, model.every.steering)) {
     const sensors::SteeringSample m = s.steering.measure(s.car.steering, s.now);
     hal::SteeringAngle a{m.stamp, m.angle};
     s.faults.apply(s.t, a);
@@ -85,7 +94,7 @@ void vcu_due(const SimModel& model, SimState& s) {
   if (const std::optional<double> tank = s.faults.ebs_tank(s.t)) s.vcu.set_ebs_tank(*tank);
   const bool pressed = s.faults.res_pressed(s.t);
   if (pressed && !s.vcu.ebs_fired()) s.vcu.res_emergency(s.now);
-  if (s.k % model.every.vcu_status != 0) return;
+  if (!falls_due(s.due_in.vcu_status, model.every.vcu_status)) return;
   post_can(s, s.vcu.status(s.now));
   // the RES's frame goes on repeating the emergency stop
   if (pressed) post_can(s, hal::ResSignal{s.now, false, true});
@@ -146,7 +155,7 @@ void sample(const SimModel& model, SimState& s, const Pose2& base) {
 void run_due(const SimModel& model, SimState& s, const Pose2& base) {
   s.hal.set_now(s.now);
   s.sensed = false;
-  if (!model.raw_perception && s.k % model.every.cone_sensor == 0) {
+  if (!model.raw_perception && falls_due(s.due_in.cone_sensor, model.every.cone_sensor)) {
     measure_cones(s, base);
     s.sensed = true;
   }
@@ -161,12 +170,12 @@ void run_due(const SimModel& model, SimState& s, const Pose2& base) {
   measure_odometry(model, s, base);
   vcu_due(model, s);
   // the stack's cycle, unless its computer stalls
-  s.controlled = s.k % model.every.control == 0 && s.faults.control_runs(s.t);
+  s.controlled = falls_due(s.due_in.control, model.every.control) && s.faults.control_runs(s.t);
   if (s.controlled) control(model, s, base);
   // the VCU's watchdog and the EBS, then what the actuators hold until the next step
   s.input = s.vcu.actuate(s.now);
   s.faults.apply(s.t, s.input);
-  s.sampled = s.k % model.every.log == 0;
+  s.sampled = falls_due(s.due_in.log, model.every.log);
   if (s.sampled) sample(model, s, base);
 }
 
