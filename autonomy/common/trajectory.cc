@@ -59,11 +59,12 @@ TrajectoryProjection project(const Trajectory& traj, Vec2 q, double s_hint, doub
   double best_d2 = INFINITY;
   double best_s = 0.0;
   double best_side = 0.0;
-  for (long k = first; k <= last; ++k) {
-    const long m = static_cast<long>(nseg);
-    const auto i = static_cast<std::size_t>(((k % m) + m) % m);
+  // segment k is segment k mod nseg (a closed window wraps past the start)
+  const long m = static_cast<long>(nseg);
+  auto i = static_cast<std::size_t>(((first % m) + m) % m);
+  for (long k = first; k <= last; ++k, i = i + 1 == nseg ? 0 : i + 1) {
     const Vec2 a = traj.points[i].position();
-    const Vec2 b = traj.points[(i + 1) % n].position();
+    const Vec2 b = traj.points[i + 1 == n ? 0 : i + 1].position();
     const auto [t, d2] = project_on_segment(q, a, b);
     if (d2 < best_d2) {
       best_d2 = d2;

@@ -67,9 +67,10 @@ LookAhead find_lookahead(const Trajectory& traj, Vec2 rear_axle, double s_rear, 
   if (traj.closed) max_arc = std::min(max_arc, traj.length);
   if (distance(a, rear_axle) < L_d) {
     auto i = static_cast<std::size_t>(std::floor(s0 / step)) + 1;
-    for (; s_a - s0 < max_arc; ++i) {
+    std::size_t at = i % n;  // i mod n, counted on with i
+    for (; s_a - s0 < max_arc; ++i, at = at + 1 == n ? 0 : at + 1) {
       if (!traj.closed && i >= n) break;  // the end of an open trajectory
-      const Vec2 b = traj.points[i % n].position();
+      const Vec2 b = traj.points[at].position();
       const double s_b = static_cast<double>(i) * step;  // unwrapped
       if (distance(b, rear_axle) >= L_d) {
         // |a + t (b - a) - c| = L_d: one root in (0, 1], since a is inside the
