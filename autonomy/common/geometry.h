@@ -68,10 +68,14 @@ struct Box {
   }
 };
 
-// angle wrapped into [-pi, pi)
+// angle wrapped into [-pi, pi) (fmod only when a + pi lies outside [0, 2 pi):
+// inside, fmod would return it unchanged, exactly)
 inline double wrap_angle(double a) {
-  a = std::fmod(a + kPi, 2.0 * kPi);
-  if (a < 0.0) a += 2.0 * kPi;
+  a += kPi;
+  if (!(a >= 0.0 && a < 2.0 * kPi)) {
+    a = std::fmod(a, 2.0 * kPi);
+    if (a < 0.0) a += 2.0 * kPi;
+  }
   return a - kPi;
 }
 

@@ -10,6 +10,7 @@ namespace paddock {
 
 double Trajectory::wrap(double s) const {
   if (closed) {
+    if (s >= 0.0 && s < length) return s;  // what fmod would return, exactly
     s = std::fmod(s, length);
     return s < 0.0 ? s + length : s;
   }

@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
+#include <random>
 
 namespace paddock {
 namespace {
@@ -22,6 +24,25 @@ TEST(Trajectory, FinitePointChecksWhatAControllerFollows) {
   TrajectoryPoint p = ok;
   p.s = nan;
   EXPECT_TRUE(finite(p));
+}
+
+// a closed trajectory's arc length wrapped into [0, length): the bits fmod gives
+TEST(Trajectory, ClosedWrapGivesTheBitsOfFmod) {
+  Trajectory t;
+  t.closed = true;
+  t.length = 318.37;
+  std::vector<double> s = {0.0, -0.0, t.length, -t.length, std::nextafter(t.length, 0.0), 2.5 * t.length,
+                           -2.5 * t.length, 1e-300, -1e-300};
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(-3.0 * t.length, 3.0 * t.length);
+  for (int i = 0; i < 100000; ++i) s.push_back(u(rng));
+  for (const double x : s) {
+    double expected = std::fmod(x, t.length);
+    if (expected < 0.0) expected += t.length;
+    const double w = t.wrap(x);
+    EXPECT_EQ(std::memcmp(&w, &expected, sizeof w), 0) << x << ": " << w << " against " << expected;
+  }
+  EXPECT_TRUE(std::isnan(t.wrap(std::nan(""))));
 }
 
 }  // namespace
