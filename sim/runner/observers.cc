@@ -186,14 +186,9 @@ SlamMetrics SlamScorer::metrics(const SimModel& model, const SimState& state, co
   m.ate_rms = std::sqrt(sum2_ / static_cast<double>(n_));
   m.heading_rms = std::sqrt(heading2_ / static_cast<double>(n_));
   m.ate_max = max_;
-  std::vector<Pose2> truth, estimate;
-  truth.reserve(series.size());
-  estimate.reserve(series.size());
-  for (const SlamSample& x : series) {
-    truth.push_back(x.truth);
-    estimate.push_back(x.estimate);
-  }
-  m.drift = relative_drift(truth, estimate, 100.0, 10.0);
+  m.drift = relative_drift(
+      series.size(), [&series](std::size_t i) -> const Pose2& { return series[i].truth; },
+      [&series](std::size_t i) -> const Pose2& { return series[i].estimate; }, 100.0, 10.0);
   return m;
 }
 

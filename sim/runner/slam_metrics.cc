@@ -60,30 +60,9 @@ MapMetrics map_metrics(const std::vector<Cone>& map, const std::vector<Cone>& tr
 
 Drift relative_drift(const std::vector<Pose2>& truth, const std::vector<Pose2>& estimate, double length,
                      double step) {
-  Drift d;
-  const std::size_t n = std::min(truth.size(), estimate.size());
-  if (n < 2) return d;
-  // the true travelled distance at each sample
-  std::vector<double> s(n, 0.0);
-  for (std::size_t i = 1; i < n; ++i) s[i] = s[i - 1] + distance(truth[i - 1].position(), truth[i].position());
-  double next = 0.0;
-  std::size_t j = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (s[i] < next) continue;
-    next = s[i] + step;
-    j = std::max(j, i);
-    while (j < n && s[j] < s[i] + length) ++j;
-    if (j == n) break;
-    const Pose2 e = between(between(truth[i], truth[j]), between(estimate[i], estimate[j]));
-    d.translation += norm(e.position());
-    d.rotation += std::abs(e.yaw);
-    ++d.windows;
-  }
-  if (d.windows > 0) {
-    d.translation /= d.windows;
-    d.rotation /= d.windows;
-  }
-  return d;
+  return relative_drift(
+      std::min(truth.size(), estimate.size()), [&truth](std::size_t i) -> const Pose2& { return truth[i]; },
+      [&estimate](std::size_t i) -> const Pose2& { return estimate[i]; }, length, step);
 }
 
 }  // namespace paddock::runner

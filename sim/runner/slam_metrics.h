@@ -7,6 +7,9 @@
 //     have seen)
 //   rmse: of the matched pairs' distances
 //   colour accuracy: matched pairs whose colour is the true one (unknown is wrong)
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <vector>
 
 #include "autonomy/common/cone.h"
@@ -42,5 +45,34 @@ struct Drift {
 };
 Drift relative_drift(const std::vector<Pose2>& truth, const std::vector<Pose2>& estimate, double length = 100.0,
                      double step = 10.0);
+
+// the same over n samples read in place: truth(i) and estimate(i) give the
+// i-th sample's poses (a run's series, without copying its poses out)
+template <class Truth, class Estimate>
+Drift relative_drift(std::size_t n, const Truth& truth, const Estimate& estimate, double length, double step) {
+  Drift d;
+  if (n < 2) return d;
+  // the true travelled distance at each sample
+  std::vector<double> s(n, 0.0);
+  for (std::size_t i = 1; i < n; ++i) s[i] = s[i - 1] + distance(truth(i - 1).position(), truth(i).position());
+  double next = 0.0;
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (s[i] < next) continue;
+    next = s[i] + step;
+    j = std::max(j, i);
+    while (j < n && s[j] < s[i] + length) ++j;
+    if (j == n) break;
+    const Pose2 e = between(between(truth(i), truth(j)), between(estimate(i), estimate(j)));
+    d.translation += norm(e.position());
+    d.rotation += std::abs(e.yaw);
+    ++d.windows;
+  }
+  if (d.windows > 0) {
+    d.translation /= d.windows;
+    d.rotation /= d.windows;
+  }
+  return d;
+}
 
 }  // namespace paddock::runner
