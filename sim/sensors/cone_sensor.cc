@@ -114,6 +114,7 @@ hal::ConeDetections ConeSensor::measure(const std::vector<Cone>& cones, const st
   });
 
   covered_.clear();
+  out.cones.reserve(candidates_.size());  // at most one detection a candidate (then the false ones)
   const double half_fov = 0.5 * p.fov;
   for (const Candidate& k : candidates_) {
     const double r = std::sqrt(k.range2);
