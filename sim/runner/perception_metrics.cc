@@ -39,7 +39,8 @@ void PerceptionMetrics::add(const hal::ConeDetections& perceived, const Pose2& b
                             const std::vector<Cone>& truth, const std::vector<bool>& visible) {
   ++frames_;
   const Vec2 sensor = base_pose.transform(sensor_in_base);
-  std::vector<Vec2> seen(perceived.cones.size());
+  std::vector<Vec2>& seen = seen_;
+  seen.resize(perceived.cones.size());
   for (std::size_t i = 0; i < seen.size(); ++i) seen[i] = base_pose.transform(perceived.cones[i].position);
 
   // the true cones within the radius of the frame's bounding box (a frame
@@ -47,10 +48,12 @@ void PerceptionMetrics::add(const hal::ConeDetections& perceived, const Pose2& b
   // radius, nearest first
   Box frame;
   for (const Vec2& p : seen) frame.add(p);
-  std::vector<std::size_t> near;
+  std::vector<std::size_t>& near = near_;
+  near.clear();
   for (std::size_t j = 0; j < truth.size(); ++j)
     if (frame.near(truth[j].position, match_radius_)) near.push_back(j);
-  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  auto& pairs = pairs_;
+  pairs.clear();
   for (std::size_t i = 0; i < seen.size(); ++i) {
     if (!std::isfinite(seen[i].x) || !std::isfinite(seen[i].y)) continue;
     for (const std::size_t j : near) {
@@ -63,12 +66,14 @@ void PerceptionMetrics::add(const hal::ConeDetections& perceived, const Pose2& b
     }
   }
   std::sort(pairs.begin(), pairs.end());
-  std::vector<long> match_of_seen(seen.size(), -1);
-  std::vector<bool> truth_taken(truth.size(), false);
+  std::vector<long>& match_of_seen = match_of_seen_;
+  match_of_seen.assign(seen.size(), -1);
+  std::vector<char>& truth_taken = truth_taken_;
+  truth_taken.assign(truth.size(), 0);
   for (const auto& [d, i, j] : pairs) {
     if (match_of_seen[i] >= 0 || truth_taken[j]) continue;
     match_of_seen[i] = static_cast<long>(j);
-    truth_taken[j] = true;
+    truth_taken[j] = 1;
   }
 
   for (std::size_t i = 0; i < seen.size(); ++i) {

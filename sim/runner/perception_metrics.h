@@ -18,6 +18,7 @@
 //   position error   mean and largest distance of the matched pairs
 #include <array>
 #include <cstddef>
+#include <tuple>
 #include <vector>
 
 #include "autonomy/common/cone.h"
@@ -66,6 +67,12 @@ class PerceptionMetrics {
   std::vector<RangeBinStats> bins_;
   double match_radius_;
   long frames_ = 0;
+  // add()'s scratch, kept between frames (no allocation a frame)
+  std::vector<Vec2> seen_;
+  std::vector<std::size_t> near_;
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs_;
+  std::vector<long> match_of_seen_;
+  std::vector<char> truth_taken_;
 };
 
 }  // namespace paddock::runner
