@@ -76,8 +76,8 @@ struct SimState {
 
   long k = 0;  // physics steps taken
   // the steps until each periodic part falls due again: k % every == 0,
-  // counted down (everything falls due at k = 0)
-  StepPeriods due_in{1, 1, 1, 1, 1, 1, 1};
+  // counted down (each starts at 1: everything falls due at k = 0)
+  StepPeriods due_in;
   TimeNs now = 0;
   double t = 0.0;  // s, k dt
   bool done = false;  // the event is over (finish or DNF): step no more
