@@ -36,6 +36,10 @@ struct EventParams {
   double standstill_speed = 0.05;
   double ready_timeout = 60.0;
 
+  // the longest a run can go on (s): the go by ready_timeout, the timeout
+  // after it, then the stop after the finish
+  double longest_run() const { return ready_timeout + timeout + stop_time; }
+
   template <class V>
   void visit(V& v) {
     v(PADDOCK_PARAM(timeout), {"s", params::in(1.0, 86400.0), "sim time after the go signal before a DNF"});

@@ -74,9 +74,8 @@ SimModel compile_model(const Scenario& scenario, const world::TrackModel& track)
   const TimeNs latency = from_seconds(scenario.perception.latency);
   m.pose_history_span = std::max(kNsPerSecond, 2 * from_seconds(1.0 / scenario.lidar.rate)) + latency;
   m.visible_scans = 4 + static_cast<std::size_t>(std::ceil(scenario.perception.latency * scenario.lidar.rate));
-  const events::EventParams& e = scenario.event;
-  const double horizon = e.ready_timeout + scenario.scenario.go_time + e.timeout + e.stop_time;
-  m.log_samples = static_cast<std::size_t>(std::min(horizon * sim.log_rate + 1.0, static_cast<double>(kMaxReservedSamples)));
+  m.log_samples = static_cast<std::size_t>(
+      std::min(scenario.event.longest_run() * sim.log_rate + 1.0, static_cast<double>(kMaxReservedSamples)));
   return m;
 }
 

@@ -57,7 +57,7 @@ struct SimModel {
   // perception's latency more
   TimeNs pose_history_span = 0;
   std::size_t visible_scans = 4;  // the scans' cones hit kept for the perception metrics
-  // the log samples of a run that lasts until its event's timeouts (at most
+  // the log samples of a run that lasts its event's longest (at most
   // kMaxReservedSamples): the per-sample records reserve this much, so that
   // they never move while they grow (pages are only touched as rows come)
   std::size_t log_samples = 0;
