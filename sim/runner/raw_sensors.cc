@@ -2,8 +2,37 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <iterator>
 
 namespace paddock::runner {
+
+namespace {
+
+// the raw points read as the HAL's (a forward iterator: a vector built from
+// a range of them is sized once and each point constructed in place)
+struct AsHalPoint {
+  using iterator_category = std::forward_iterator_tag;
+  using value_type = hal::LidarPoint;
+  using difference_type = std::ptrdiff_t;
+  using pointer = const hal::LidarPoint*;
+  using reference = hal::LidarPoint;
+  const sensors::LidarPoint* p;
+  hal::LidarPoint operator*() const { return {p->x, p->y, p->z, p->intensity, p->ring, p->t}; }
+  AsHalPoint& operator++() {
+    ++p;
+    return *this;
+  }
+  AsHalPoint operator++(int) {
+    AsHalPoint o = *this;
+    ++p;
+    return o;
+  }
+  bool operator==(const AsHalPoint& o) const { return p == o.p; }
+  bool operator!=(const AsHalPoint& o) const { return p != o.p; }
+};
+
+}  // namespace
 
 void PoseHistory::record(TimeNs now, const Pose2& base) {
   poses_.emplace_back(now, base);
@@ -163,11 +192,9 @@ const std::vector<std::int32_t>& RawSensors::emit(TimeNs now, const world::ConeW
   hal::LidarScan scan;
   scan.stamp = start;
   scan.end = scan_end(now);
-  scan.points.resize(raw.size());
-  for (std::size_t i = 0; i < raw.size(); ++i) {
-    const sensors::LidarPoint& p = raw[i];
-    scan.points[i] = hal::LidarPoint{p.x, p.y, p.z, p.intensity, p.ring, p.t};
-  }
+  // built from the raw points in one pass (a resize would first write every
+  // point as zeros)
+  scan.points.assign(AsHalPoint{raw.data()}, AsHalPoint{raw.data() + raw.size()});
   hal.post(std::move(scan));
   return truth_;
 }
