@@ -17,7 +17,7 @@ constexpr std::size_t kMaxWaiting = 4;
 }  // namespace
 
 Localisation::Localisation(const SlamParams& p, SlamMode mode, const Pose2& start)
-    : params_(p), mode_(mode), ekf_(p.velocity, p.geometry), last_frame_odom_(start), start_(start) {
+    : params_(p), mode_(mode), ekf_(p.velocity, p.geometry), published_frame_odom_(start), last_frame_odom_(start), start_(start) {
   if (mode == SlamMode::GroundTruth) throw std::invalid_argument("localisation: slam = ground_truth needs none");
   ekf_.reset(start, 0);
   if (mode_ == SlamMode::FastSlam || mode_ == SlamMode::FastSlamGraph || mode_ == SlamMode::LioGraph) {
@@ -131,6 +131,14 @@ void Localisation::on_detections(const hal::ConeDetections& d) {
   }
 }
 
+Localisation::OdometryAt Localisation::odometry_for(TimeNs stamp, Pose2& odom) const {
+  if (odom_.empty() || stamp > odom_.back().stamp) return OdometryAt::Later;
+  const std::optional<Pose2> o = odometry_at(stamp);
+  if (!o) return OdometryAt::Gone;
+  odom = *o;
+  return OdometryAt::Ready;
+}
+
 std::optional<Pose2> Localisation::odometry_at(TimeNs t) const {
   if (odom_.empty() || t < odom_.front().stamp || t > odom_.back().stamp) return std::nullopt;
   std::size_t i = 1;
@@ -143,25 +151,36 @@ std::optional<Pose2> Localisation::odometry_at(TimeNs t) const {
 }
 
 void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
+  step(d, odom, process_step_);
+  publish(process_step_);
+}
+
+void Localisation::step(const hal::ConeDetections& d, const Pose2& odom, SlamStep& out) {
   const auto t0 = std::chrono::steady_clock::now();
+  step_ = &out;
+  out.map_news = false;
+  out.frames = 1;
+  out.empty_frames = out.lost_frames = 0;
+  out.loop_closures = out.graph_failures = out.relocalisations = out.relocalisation_failures = 0;
+  out.optimise_ms.clear();
+  out.last_fault.clear();
   const Pose2 delta = between(last_frame_odom_, odom);
   fastslam_->predict(delta);
   driven_ += std::hypot(delta.x, delta.y);
   last_frame_odom_ = odom;
-  ++stats_.frames;
   if (d.cones.empty()) {
     // no cone at all is a sensor's failure more likely than an empty track:
     // the map is not told that its cones in view went unseen
-    ++stats_.empty_frames;
-    stats_.last_fault = "a frame without a cone";
+    out.empty_frames = 1;
+    out.last_fault = "a frame without a cone";
   } else {
     std::vector<slam::Observation> obs;
     obs.reserve(d.cones.size());
     for (const hal::DetectedCone& c : d.cones) obs.push_back({c.position, c.color, c.colour_from_camera});
     fastslam_->update(obs, d.free_range);
-    map_news_ = true;
+    out.map_news = true;
     lost_run_ = lost_in_frame() ? lost_run_ + 1 : 0;
-    if (lost_run_ > 0) ++stats_.lost_frames;
+    if (lost_run_ > 0) out.lost_frames = 1;
     // (slam = lio: the pose is the LIO's, the cones do not move it)
     if (lost_run_ >= params_.relocalisation.lost_frames && mode_ != SlamMode::Lio) relocalise_on(obs);
     if (graph() && lost_run_ == 0) {
@@ -170,13 +189,50 @@ void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
       if (closure) optimise_graph();
     }
   }
-  correction_ = compose(fastslam_->pose(), between(odom, Pose2{}));
+  out.correction = compose(fastslam_->pose(), between(odom, Pose2{}));
   const Eigen::Matrix3d cov = fastslam_->pose_covariance();
-  slam_variance_ = cov(0, 0) + cov(1, 1);
-  slam_yaw_variance_ = cov(2, 2);
-  last_frame_stamp_ = d.stamp;
+  out.slam_variance = cov(0, 0) + cov(1, 1);
+  out.slam_yaw_variance = cov(2, 2);
+  out.stamp = d.stamp;
+  out.frame_odom = odom;
+  out.lost_run = lost_run_;
+  if (out.map_news) {
+    // SLAM's map: the confirmed landmarks of the highest-weight particle
+    out.map.clear();
+    for (const slam::Landmark& l : fastslam_->map()) {
+      slam::MappedCone m;
+      m.position = l.mean;
+      m.observations = l.sightings;
+      m.votes = l.votes;
+      out.map.push_back(m);
+    }
+  }
+  step_ = nullptr;
   const auto t1 = std::chrono::steady_clock::now();
-  stats_.update_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+  out.update_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+}
+
+void Localisation::publish(SlamStep& s) {
+  correction_ = s.correction;
+  slam_variance_ = s.slam_variance;
+  slam_yaw_variance_ = s.slam_yaw_variance;
+  last_frame_stamp_ = s.stamp;
+  published_frame_odom_ = s.frame_odom;
+  published_lost_run_ = s.lost_run;
+  if (s.map_news) {
+    map_.swap(s.map);
+    map_news_ = true;
+  }
+  stats_.frames += s.frames;
+  stats_.empty_frames += s.empty_frames;
+  stats_.lost_frames += s.lost_frames;
+  stats_.loop_closures += s.loop_closures;
+  stats_.graph_failures += s.graph_failures;
+  stats_.relocalisations += s.relocalisations;
+  stats_.relocalisation_failures += s.relocalisation_failures;
+  stats_.optimise_ms.insert(stats_.optimise_ms.end(), s.optimise_ms.begin(), s.optimise_ms.end());
+  stats_.update_ms.push_back(s.update_ms);
+  if (!s.last_fault.empty()) stats_.last_fault = s.last_fault;
 }
 
 void Localisation::record_node(const Pose2& odom, bool closure) {
@@ -208,7 +264,7 @@ bool Localisation::closes_loop() const {
 
 void Localisation::optimise_graph() {
   const auto t0 = std::chrono::steady_clock::now();
-  ++stats_.loop_closures;
+  ++step_->loop_closures;
   last_closure_at_ = driven_;
   closure_nodes_.push_back(static_cast<int>(nodes_.size()) - 1);
   // the window: from the closure window_laps back (the start until then)
@@ -234,8 +290,8 @@ void Localisation::optimise_graph() {
   const int held = params_.loop_closure.hold_optimised && optimised_until_ >= first ? optimised_until_ - first + 1 : 1;
   const slam::PoseGraph::Result r = graph.optimise(held);
   if (!r.ok) {
-    ++stats_.graph_failures;
-    stats_.last_fault = "pose graph: " + r.reason;
+    ++step_->graph_failures;
+    step_->last_fault = "pose graph: " + r.reason;
   } else {
     for (int i = first; i < static_cast<int>(nodes_.size()); ++i) nodes_[i].estimate = graph.pose(i - first);
     optimised_until_ = static_cast<int>(nodes_.size()) - 1;
@@ -247,7 +303,7 @@ void Localisation::optimise_graph() {
     fastslam_->reanchor(nodes_.back().estimate, map, std::numeric_limits<std::int64_t>::max(),
                         params_.fastslam.closed_particles);
   }
-  stats_.optimise_ms.push_back(
+  step_->optimise_ms.push_back(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
 }
 
@@ -280,12 +336,12 @@ void Localisation::relocalise_on(const std::vector<slam::Observation>& obs) {
   const std::optional<slam::Relocalisation> r =
       slam::relocalise(map, points, fastslam_->pose(), params_.relocalisation);
   if (!r) {
-    ++stats_.relocalisation_failures;
-    stats_.last_fault = "lost: no pose near the estimate fits the map";
+    ++step_->relocalisation_failures;
+    step_->last_fault = "lost: no pose near the estimate fits the map";
     return;
   }
-  ++stats_.relocalisations;
-  stats_.last_fault = "lost: relocalised";
+  ++step_->relocalisations;
+  step_->last_fault = "lost: relocalised";
   fastslam_->reanchor(r->pose, {}, lost_since);
   lost_run_ = 0;
   // the odometry's chain broke where the car was moved: the graph starts
@@ -308,7 +364,7 @@ double Localisation::position_variance() const {
   }
   if (!fastslam_) return odometry_variance();
   const estimation::VelocityEstimate e = ekf_.estimate();
-  const double d2 = squared_norm(e.pose.position() - last_frame_odom_.position());
+  const double d2 = squared_norm(e.pose.position() - published_frame_odom_.position());
   const double dt = std::max(0.0, to_seconds(e.stamp - last_frame_stamp_));
   const double added = d2 * slam_yaw_variance_ + dt * dt * (e.variance[estimation::kVx] + e.variance[estimation::kVy]) +
                        0.25 * d2 * dt * dt * e.variance[estimation::kR];
@@ -321,17 +377,5 @@ bool Localisation::take_map_news() {
   return news;
 }
 
-std::vector<slam::MappedCone> Localisation::map() const {
-  std::vector<slam::MappedCone> out;
-  if (!fastslam_) return out;
-  for (const slam::Landmark& l : fastslam_->map()) {
-    slam::MappedCone m;
-    m.position = l.mean;
-    m.observations = l.sightings;
-    m.votes = l.votes;
-    out.push_back(m);
-  }
-  return out;
-}
 
 }  // namespace paddock::stack

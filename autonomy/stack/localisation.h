@@ -148,6 +148,26 @@ struct LocalisationStats {
   std::string last_fault;   // the reason of the last fallback
 };
 
+// one frame's SLAM update (Localisation::step) and what it changes of what
+// the localisation tells (Localisation::publish). Reused frame after frame
+// (its buffers kept)
+struct SlamStep {
+  Pose2 correction;   // map <- odometry after the frame
+  Pose2 frame_odom;   // the odometry at the frame's stamp
+  double slam_variance = 0.0, slam_yaw_variance = 0.0;
+  TimeNs stamp = 0;
+  int lost_run = 0;
+  bool map_news = false;
+  std::vector<slam::MappedCone> map;  // SLAM's map after the frame, when map_news
+  // what the frame adds to the stats: its counts, the graph's solve, the
+  // update's wall time, its last fault (empty: none)
+  long frames = 0, empty_frames = 0, lost_frames = 0;
+  int loop_closures = 0, graph_failures = 0, relocalisations = 0, relocalisation_failures = 0;
+  std::vector<double> optimise_ms;
+  double update_ms = 0.0;
+  std::string last_fault;
+};
+
 class Localisation {
  public:
   // throws std::invalid_argument on invalid params; mode != GroundTruth
@@ -172,11 +192,33 @@ class Localisation {
   // true once after SLAM's map changed
   bool take_map_news();
   // SLAM's map: the confirmed landmarks of the highest-weight particle
-  std::vector<slam::MappedCone> map() const;
+  const std::vector<slam::MappedCone>& map() const { return map_; }
   const LocalisationStats& stats() const { return stats_; }
   // frames in a row in which the front end associated too little: the
   // frames and the map disagree (0: the last frame fit)
-  int lost_run() const { return lost_run_; }
+  int lost_run() const { return published_lost_run_; }
+
+  // A frame's SLAM update run beside the caller's loop (the stack's
+  // perception thread; slam = fastslam | fastslam_graph): on_detections
+  // is odometry_for, step and publish at once. step() works on SLAM's own
+  // state alone (the particles, the graph), which nothing else reads;
+  // publish() makes its result what this localisation tells (the estimates'
+  // correction, the variances, lost_run, the map and its news, the stats),
+  // on the caller's thread, when on_detections would have processed the
+  // frame. The steps must come in the frames' order, one at a time, and
+  // none while a frame waits here (idle()): then the estimates, the map and
+  // the stats are on_detections', bit for bit.
+  enum class OdometryAt { Ready, Later, Gone };
+  // where the odometry stands for a frame stamped `stamp`: Ready (odom is
+  // the pose on_detections takes), Later (not reached yet: the frame would
+  // wait), Gone (older than the odometry kept: it would be dropped)
+  OdometryAt odometry_for(TimeNs stamp, Pose2& odom) const;
+  // no frame waits for the odometry
+  bool idle() const { return waiting_.empty(); }
+  // whether step() serves this mode (not with the LIO, whose scans move the odometry)
+  bool steps_beside() const { return mode_ == SlamMode::FastSlam || mode_ == SlamMode::FastSlamGraph; }
+  void step(const hal::ConeDetections& d, const Pose2& odom, SlamStep& out);
+  void publish(SlamStep& s);
   // var(x) + var(y) of the estimate (m^2): the EKF's (odometry); SLAM's
   // covariance at the last frame plus what the odometry's motion since
   // added to it: over the time dt since the frame the base moved by d (the
@@ -207,6 +249,7 @@ class Localisation {
   std::optional<Pose2> odometry_at(TimeNs t) const;
   bool graph() const { return mode_ == SlamMode::FastSlamGraph || mode_ == SlamMode::LioGraph; }
   double odometry_variance() const;
+  // step and publish at once
   void process(const hal::ConeDetections& d, const Pose2& odom);
   // slam = fastslam_graph: the frame's node and sightings, and a closure's optimisation
   void record_node(const Pose2& odom, bool closure);
@@ -223,13 +266,20 @@ class Localisation {
   std::optional<slam::Lio> lio_;
   std::deque<Odom> odom_;                    // the last second of odometry, oldest first
   std::deque<hal::ConeDetections> waiting_;  // frames newer than the odometry
-  Pose2 last_frame_odom_;                    // the odometry at the last processed frame
+  // what it tells (publish)
+  Pose2 published_frame_odom_;               // the odometry at the last published frame
   Pose2 correction_;                         // map <- odometry
   double slam_variance_ = 0.0;               // SLAM's var(x) + var(y) at the last frame
   double slam_yaw_variance_ = 0.0;           // and its var(yaw)
   TimeNs last_frame_stamp_ = 0;              // that frame's stamp
+  int published_lost_run_ = 0;
   bool map_news_ = false;
+  std::vector<slam::MappedCone> map_;
   LocalisationStats stats_;
+  SlamStep process_step_;                    // process()'s
+  // SLAM's own (step)
+  SlamStep* step_ = nullptr;                 // the step under way
+  Pose2 last_frame_odom_;                    // the odometry at the last stepped frame
   // slam = fastslam_graph
   Pose2 start_;
   double driven_ = 0.0;                  // odometry distance over the frames (m)

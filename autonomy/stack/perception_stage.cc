@@ -1,5 +1,6 @@
 #include "autonomy/stack/perception_stage.h"
 
+#include <stdexcept>
 #include <utility>
 
 namespace paddock::stack {
@@ -79,6 +80,10 @@ const hal::LidarScan& PerceptionStage::post(hal::LidarScan scan, TimeNs now) {
   job->scan = std::move(scan);
   job->done = false;
   job->error = nullptr;
+  job->stepped = false;
+  job->step_done = false;
+  job->step_error = nullptr;
+  ++posted_;
   Job* j = job.get();
   jobs_.push_back(std::move(job));
   worker_.post([this, j] {
@@ -87,14 +92,38 @@ const hal::LidarScan& PerceptionStage::post(hal::LidarScan scan, TimeNs now) {
     } catch (...) {
       j->error = std::current_exception();
     }
-    {
-      const std::lock_guard<std::mutex> lock(mutex_);
-      j->done = true;
-    }
-    done_.notify_one();
+    tell(j->done);
   });
   worker_.flush();
   return j->scan;
+}
+
+void PerceptionStage::then(std::uint64_t job, std::function<void(const perception::PerceptionFrame&)> step) {
+  const std::uint64_t first = posted_ - jobs_.size();  // the oldest job not delivered
+  if (job < first || job >= posted_) throw std::logic_error("PerceptionStage::then: job not in flight");
+  Job* j = jobs_[static_cast<std::size_t>(job - first)].get();
+  if (j->stepped) throw std::logic_error("PerceptionStage::then: the job has its step already");
+  j->stepped = true;
+  worker_.post([this, j, step = std::move(step)] {
+    // (a job that threw has no frame to step on: its delivery rethrows)
+    if (!j->error) {
+      try {
+        step(j->frame);
+      } catch (...) {
+        j->step_error = std::current_exception();
+      }
+    }
+    tell(j->step_done);
+  });
+  worker_.flush();
+}
+
+void PerceptionStage::tell(bool& flag) {
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    flag = true;
+  }
+  done_.notify_one();
 }
 
 const perception::PerceptionFrame* PerceptionStage::deliver(TimeNs now) {
@@ -102,12 +131,13 @@ const perception::PerceptionFrame* PerceptionStage::deliver(TimeNs now) {
   {
     std::unique_lock<std::mutex> lock(mutex_);
     Job& front = *jobs_.front();
-    done_.wait(lock, [&front] { return front.done; });
+    done_.wait(lock, [&front] { return front.done && (!front.stepped || front.step_done); });
   }
   spare_.push_back(std::move(delivered_));
   delivered_ = std::move(jobs_.front());
   jobs_.pop_front();
   if (delivered_->error) std::rethrow_exception(std::exchange(delivered_->error, nullptr));
+  if (delivered_->step_error) std::rethrow_exception(std::exchange(delivered_->step_error, nullptr));
   return &delivered_->frame;
 }
 

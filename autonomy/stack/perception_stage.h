@@ -21,11 +21,16 @@
 // whatever the timing. The caller waits for the jobs only when a frame is
 // due (with a latency of a rotation or more the thread works beside the
 // next rotation's simulation and the stack's mapping of the last frame).
+// A caller's step on a job's frame (then(): the stack's SLAM update of it)
+// runs on the same thread after the job, and the frame's delivery waits
+// for it too.
 //
 // One caller thread (the stack's). No I/O, no clock.
 #include <condition_variable>
+#include <cstdint>
 #include <deque>
 #include <exception>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <variant>
@@ -66,6 +71,16 @@ class PerceptionStage {
   // the scan's job, its frame due at now + latency. Returns the scan as the
   // job holds it, to be read (not written) until the frame is delivered
   const hal::LidarScan& post(hal::LidarScan scan, TimeNs now);
+  // the number of the job post() made last (the first is 0)
+  std::uint64_t last_posted() const { return posted_ - 1; }
+  // a step of the caller's on job `job`'s frame, run on the jobs' thread
+  // after the job (and the jobs before it), before the frame is delivered:
+  // deliver() waits for it, and rethrows what it threw. One a job, for a
+  // job posted and not delivered yet (else std::logic_error); the step must
+  // touch nothing the caller reads until the frame is delivered
+  void then(std::uint64_t job, std::function<void(const perception::PerceptionFrame&)> step);
+  // whether the jobs run on a thread of their own ([perception] threads = 2)
+  bool threaded() const { return worker_.threaded(); }
   // the oldest frame due at or before now, once its job has run (waited
   // for; the jobs posted after it run on); null when none is due. Valid
   // until the next call. What the job threw is thrown here
@@ -97,11 +112,16 @@ class PerceptionStage {
     perception::PerceptionFrame frame;
     bool done = false;           // under mutex_
     std::exception_ptr error;    // what the job threw, rethrown at its delivery
+    bool stepped = false;        // a step follows it (then)
+    bool step_done = false;      // under mutex_
+    std::exception_ptr step_error;  // what the step threw
   };
   void queue(Input in);
   static void apply(perception::Perception& p, Input& in);
   // runs on the worker (or at once): the inputs applied, then the scan
   static void run(perception::Perception& p, Job& job);
+  // on the worker: a job's (or its step's) end, told to the caller waiting for it
+  void tell(bool& flag);
 
   perception::PerceptionParams params_;
   std::unique_ptr<perception::Perception> perception_;
@@ -111,6 +131,7 @@ class PerceptionStage {
   // posted, oldest first
   std::deque<std::unique_ptr<Job>> jobs_;
   std::vector<std::unique_ptr<Job>> spare_;
+  std::uint64_t posted_ = 0;  // jobs posted
   std::unique_ptr<Job> delivered_;
   // a job's end, told to the caller waiting for its frame
   std::mutex mutex_;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <utility>
 
 #include "autonomy/common/polyline.h"
@@ -51,6 +52,9 @@ Stack::Stack(const StackParams& params, MissionSpec spec, std::unique_ptr<percep
   }
   if (params_.autonomy.slam != SlamMode::GroundTruth)
     localisation_.emplace(params_.slam, params_.autonomy.slam, spec_.start_pose);
+  // (with no latency a scan's frame is mapped within the message that brought it)
+  slam_beside_ = perception_ && perception_->threaded() && params_.perception.latency > 0.0 && localisation_ &&
+                 localisation_->steps_beside();
   if (params_.autonomy.planner != PlannerMode::Oracle) return;
   // planner = oracle: the whole reference is planned once, before the start;
   // an open path starts free (the car launches at full drive) and ends at rest
@@ -119,6 +123,18 @@ void Stack::on_message(hal::SensorMessage&& m) {
     health_.lidar_scan(now_, scan->points.size());
     const hal::LidarScan& posted =
         timed(profile_, Stage::Perception, [&]() -> const hal::LidarScan& { return perception_->post(std::move(*scan), now_); });
+    if (slam_beside_) {
+      SlamInFlight f;
+      f.stamp = posted.end;
+      f.job = perception_->last_posted();
+      if (!slam_spare_.empty()) {
+        f.step = std::move(slam_spare_.back());
+        slam_spare_.pop_back();
+      } else {
+        f.step = std::make_unique<SlamStep>();
+      }
+      slam_in_flight_.push_back(std::move(f));
+    }
     if (localisation_) {
       const StageScope scope(profile_, Stage::Localisation);
       localisation_->on_scan(posted);
@@ -140,7 +156,36 @@ void Stack::deliver_perception(TimeNs now) {
         timed(profile_, Stage::Perception, [&] { return perception_->deliver(now); });
     if (f == nullptr) return;
     const StageScope mapping(profile_, Stage::Localisation);
-    on_detections(f->output);
+    if (!slam_beside_) {
+      on_detections(f->output);
+      continue;
+    }
+    // the oldest in flight is this frame: published if it was stepped
+    // beside, else mapped as on one thread
+    SlamInFlight done = std::move(slam_in_flight_.front());
+    slam_in_flight_.pop_front();
+    on_detections(f->output, done.stepped ? done.step.get() : nullptr);
+    if (done.stepped) ++slam_steps_beside_;
+    slam_spare_.push_back(std::move(done.step));
+  }
+}
+
+void Stack::post_slam_steps() {
+  // in the frames' order, and none while a frame mapped on this thread
+  // waits for its odometry: the steps then come in the order, and at the
+  // odometry, on_detections takes them in
+  for (SlamInFlight& f : slam_in_flight_) {
+    if (f.stepped) continue;
+    Pose2 odom;
+    if (!localisation_->idle() || localisation_->odometry_for(f.stamp, odom) != Localisation::OdometryAt::Ready) return;
+    Localisation* loc = &*localisation_;
+    SlamStep* step = f.step.get();
+    const TimeNs stamp = f.stamp;
+    perception_->then(f.job, [loc, step, odom, stamp](const perception::PerceptionFrame& frame) {
+      if (frame.output.stamp != stamp) throw std::logic_error("slam beside the loop: a frame not stamped at its scan's end");
+      loc->step(frame.output, odom, *step);
+    });
+    f.stepped = true;
   }
 }
 
@@ -156,12 +201,16 @@ std::optional<Pose2> Stack::pose_at(TimeNs t) const {
   return interpolate(a.pose, b.pose, f);
 }
 
-void Stack::on_detections(const hal::ConeDetections& d) {
+void Stack::on_detections(const hal::ConeDetections& d, SlamStep* stepped) {
   last_detections_ = d;
   ++detection_frames_;
   // slam = fastslam or fastslam_graph: the map is SLAM's
   if (localisation_ && localisation_->owns_map()) {
-    localisation_->on_detections(d);
+    if (stepped != nullptr) {
+      localisation_->publish(*stepped);
+    } else {
+      localisation_->on_detections(d);
+    }
     return;
   }
   // slam = ground_truth: the detections go into the map at the pose the car
@@ -600,6 +649,8 @@ double Stack::emergency_steering(TimeNs now, double dt) {
 void Stack::tick(TimeNs now, hal::Hal& hal) {
   now_ = now;
   while (auto m = hal.receive()) on_message(std::move(*m));
+  // (after the messages: the odometry at a scan's end comes just after it)
+  if (slam_beside_) post_slam_steps();
   // the cones of the scans whose processing has taken [perception] latency
   // by now (after this cycle's messages: a scan that came in them is on its
   // way meanwhile)

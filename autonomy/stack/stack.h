@@ -251,6 +251,9 @@ class Stack {
   // how many frames came so far: for the perception metrics
   const hal::ConeDetections& last_detections() const { return last_detections_; }
   long detection_frames() const { return detection_frames_; }
+  // the frames whose SLAM update ran beside the loop, on the perception's
+  // thread (slam_beside_; the rest were mapped on the stack's thread)
+  long slam_steps_beside() const { return slam_steps_beside_; }
   // where the stack's time goes, by stage (perception, localisation,
   // planning, control), timed into `profile` from now on; null: not timed
   void set_profile(Profile* profile) { profile_ = profile; }
@@ -259,7 +262,8 @@ class Stack {
   void on_message(hal::SensorMessage&& m);
   // a state estimate the stack now drives on (handed in, or its own)
   void take_estimate(const hal::StateEstimate& est);
-  void on_detections(const hal::ConeDetections& d);
+  // stepped: the frame's SLAM step, done beside the loop (published here)
+  void on_detections(const hal::ConeDetections& d, SlamStep* stepped = nullptr);
   // perception's frames due by now, into the map
   void deliver_perception(TimeNs now);
   void add_to_map(const hal::ConeDetections& d);
@@ -329,10 +333,30 @@ class Stack {
   control::Controller controller_;
   Telemetry telemetry_;
   Profile* profile_ = nullptr;
-  std::unique_ptr<PerceptionStage> perception_;
 
   // slam != ground_truth: the stack's own estimate, from the HAL's sensors
   std::optional<Localisation> localisation_;
+  // SLAM beside the loop ([perception] threads = 2 with a latency, slam =
+  // fastslam | fastslam_graph): each scan's frame is stepped through SLAM
+  // on the perception's thread once the odometry has reached its stamp, and
+  // published when the frame is delivered (Localisation::step, publish).
+  // The frames in flight, oldest first: each with its job, whether its step
+  // was posted, and the step
+  struct SlamInFlight {
+    TimeNs stamp = 0;
+    std::uint64_t job = 0;
+    bool stepped = false;
+    std::unique_ptr<SlamStep> step;
+  };
+  bool slam_beside_ = false;
+  long slam_steps_beside_ = 0;
+  std::deque<SlamInFlight> slam_in_flight_;
+  std::vector<std::unique_ptr<SlamStep>> slam_spare_;
+  // the steps of the frames in flight whose odometry has come, in order
+  void post_slam_steps();
+  // perception = lidar | lidar_camera (last: its thread, which runs the
+  // SLAM steps, ends before the localisation and the steps go)
+  std::unique_ptr<PerceptionStage> perception_;
   std::optional<hal::StateEstimate> state_;
   std::deque<hal::StateEstimate> history_;  // the last second of state estimates, oldest first
   slam::ConeMap cone_map_;

@@ -197,8 +197,8 @@ TEST(Cli, SameScenarioAndSeedGiveIdenticalSummaryAndLog) {
 
 TEST(Cli, WithAPerceptionLatencyTheScansGoOnAThreadOfTheirOwnAndTheResultStays) {
   // the default scenario's first 20 s after the go with a rotation's latency:
-  // on one thread, and on two (the scans processed beside the loop,
-  // FastSLAM's particles on the loop's thread alone): the same log
+  // on one thread, and on two (the scans processed beside the loop, and
+  // each frame's SLAM update after them on the scans' thread): the same log
   const std::string scenario =
       kRoot + "/scenarios/fsg_2023_trackdrive.ini --set event.timeout=20 --set perception.latency=0.1";
   const auto a = paddock("run " + scenario + " --out " + scratch("lat_a"));

@@ -42,6 +42,7 @@ struct Trace {
   std::vector<LogRow> log;
   long scans = 0;
   long steps = 0;
+  long slam_steps_beside = 0;  // frames SLAM took in on the perception's thread
   events::Result event;
 };
 Trace drive(const SimModel& model) {
@@ -59,6 +60,7 @@ Trace drive(const SimModel& model) {
   out.log = log.rows();
   out.scans = scorer.metrics().frames();
   out.event = state.event.result();
+  out.slam_steps_beside = state.stack.slam_steps_beside();
   return out;
 }
 
@@ -178,6 +180,9 @@ TEST(Simulation, APerceptionLatencyDelaysEachFrameAndTheScansThreadChangesNothin
     const Trace two = drive(compile_model(sc, s.track));
     EXPECT_TRUE(same_rows(one.log, two.log)) << latency;
     EXPECT_EQ(one.scans, two.scans);
+    // (and FastSLAM's update of each frame went beside the loop too)
+    EXPECT_EQ(one.slam_steps_beside, 0) << latency;
+    EXPECT_GT(two.slam_steps_beside, 40) << latency;
   }
 }
 

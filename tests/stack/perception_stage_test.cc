@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
@@ -253,6 +254,71 @@ TEST(PerceptionStage, InputsWithNoScanToTakeThemAreAppliedInTheirOrder) {
     for (std::size_t k = 0; k < got.size(); ++k) expect_same(got[k].frame, ref[k], "frame " + std::to_string(k));
     EXPECT_TRUE(got.back().frame.lidar.corrected);
   }
+}
+
+TEST(PerceptionStage, AStepOnAFrameRunsBesideTheCallerBeforeTheFrameIsDelivered) {
+  // two threads, a latency of two rotations (two frames in flight): each
+  // scan's step is attached some control cycles after its post (as the
+  // stack's SLAM step waits for the odometry), sees its own frame (the
+  // reference's cones), and has run, in the posts' order, when deliver()
+  // gives the frame; a step attached to a job not in flight is refused, and
+  // what a step throws comes out of its frame's delivery
+  const std::vector<Event> events = drive(6);
+  const std::vector<perception::PerceptionFrame> ref = reference(events);
+  PerceptionStage stage(stage_params(0.2, 2), nullptr);
+  ASSERT_TRUE(stage.threaded());
+  std::vector<std::size_t> stepped;  // the frames' cone counts, in the steps' order (the stage's thread's)
+  std::vector<std::uint64_t> unstepped;  // posted, no step yet (oldest first)
+  std::size_t delivered = 0, checked = 0;
+  const auto deliver = [&](TimeNs now) {
+    while (const perception::PerceptionFrame* f = stage.deliver(now)) {
+      ASSERT_LT(delivered, ref.size());
+      // its step ran before (the deliveries read the list only now, on this thread)
+      ASSERT_GT(stepped.size(), delivered);
+      EXPECT_EQ(stepped[delivered], ref[delivered].output.cones.size());
+      EXPECT_EQ(f->output.cones.size(), ref[delivered].output.cones.size());
+      ++delivered;
+      ++checked;
+    }
+  };
+  TimeNs tick = 0;
+  for (const Event& e : events) {
+    for (; tick < e.at; tick += 10'000'000) {
+      // a cycle after the post: the step of the oldest frame without one
+      if (!unstepped.empty()) {
+        stage.then(unstepped.front(), [&stepped](const perception::PerceptionFrame& f) { stepped.push_back(f.output.cones.size()); });
+        EXPECT_THROW(stage.then(unstepped.front(), [](const perception::PerceptionFrame&) {}), std::logic_error);
+        unstepped.erase(unstepped.begin());
+      }
+      deliver(tick);
+    }
+    if (const auto* m = std::get_if<hal::Imu>(&e.what)) stage.add(*m);
+    if (const auto* m = std::get_if<hal::WheelSpeeds>(&e.what)) stage.add(*m);
+    if (const auto* m = std::get_if<hal::CameraDetections>(&e.what)) stage.add(*m);
+    if (const auto* m = std::get_if<hal::LidarScan>(&e.what)) {
+      stage.post(*m, e.at);
+      unstepped.push_back(stage.last_posted());
+    }
+  }
+  for (; tick <= from_seconds(2.0); tick += 10'000'000) {
+    if (!unstepped.empty()) {
+      stage.then(unstepped.front(), [&stepped](const perception::PerceptionFrame& f) { stepped.push_back(f.output.cones.size()); });
+      unstepped.erase(unstepped.begin());
+    }
+    deliver(tick);
+  }
+  EXPECT_EQ(checked, ref.size());
+  EXPECT_EQ(stage.in_flight(), 0u);
+  // delivered: no step any more
+  EXPECT_THROW(stage.then(stage.last_posted(), [](const perception::PerceptionFrame&) {}), std::logic_error);
+  // a step that throws: its frame's delivery says so
+  const hal::LidarScan* scan = nullptr;
+  for (const Event& e : events)
+    if (const auto* m = std::get_if<hal::LidarScan>(&e.what)) scan = m;
+  ASSERT_NE(scan, nullptr);
+  stage.post(*scan, from_seconds(3.0));
+  stage.then(stage.last_posted(), [](const perception::PerceptionFrame&) { throw std::runtime_error("step failed"); });
+  EXPECT_THROW(stage.deliver(from_seconds(3.5)), std::runtime_error);
 }
 
 }  // namespace
