@@ -206,15 +206,14 @@ class Localisation {
   // correction, the variances, lost_run, the map and its news, the stats),
   // on the caller's thread, when on_detections would have processed the
   // frame. The steps must come in the frames' order, one at a time, and
-  // none while a frame waits here (idle()): then the estimates, the map and
-  // the stats are on_detections', bit for bit.
+  // none while a frame waits here for its odometry (so none before
+  // odometry_for says Ready): then the estimates, the map and the stats are
+  // on_detections', bit for bit.
   enum class OdometryAt { Ready, Later, Gone };
   // where the odometry stands for a frame stamped `stamp`: Ready (odom is
   // the pose on_detections takes), Later (not reached yet: the frame would
   // wait), Gone (older than the odometry kept: it would be dropped)
   OdometryAt odometry_for(TimeNs stamp, Pose2& odom) const;
-  // no frame waits for the odometry
-  bool idle() const { return waiting_.empty(); }
   // whether step() serves this mode (not with the LIO, whose scans move the odometry)
   bool steps_beside() const { return mode_ == SlamMode::FastSlam || mode_ == SlamMode::FastSlamGraph; }
   void step(const hal::ConeDetections& d, const Pose2& odom, SlamStep& out);

@@ -171,13 +171,15 @@ void Stack::deliver_perception(TimeNs now) {
 }
 
 void Stack::post_slam_steps() {
-  // in the frames' order, and none while a frame mapped on this thread
-  // waits for its odometry: the steps then come in the order, and at the
-  // odometry, on_detections takes them in
+  // in the frames' order, each once the odometry has reached its stamp: the
+  // steps then come in the order, and at the odometry, on_detections takes
+  // them in. (None while a frame mapped on this thread waits for its
+  // odometry: the localisation maps a waiting frame in the IMU sample that
+  // reaches its stamp, so while one waits every later frame's is Later too)
   for (SlamInFlight& f : slam_in_flight_) {
     if (f.stepped) continue;
     Pose2 odom;
-    if (!localisation_->idle() || localisation_->odometry_for(f.stamp, odom) != Localisation::OdometryAt::Ready) return;
+    if (localisation_->odometry_for(f.stamp, odom) != Localisation::OdometryAt::Ready) return;
     Localisation* loc = &*localisation_;
     SlamStep* step = f.step.get();
     const TimeNs stamp = f.stamp;

@@ -42,7 +42,8 @@ struct Trace {
   std::vector<LogRow> log;
   long scans = 0;
   long steps = 0;
-  long slam_steps_beside = 0;  // frames SLAM took in on the perception's thread
+  long frames = 0;             // frames of cones the stack took in
+  long slam_steps_beside = 0;  // of them, those SLAM took in on the perception's thread
   events::Result event;
 };
 Trace drive(const SimModel& model) {
@@ -60,6 +61,7 @@ Trace drive(const SimModel& model) {
   out.log = log.rows();
   out.scans = scorer.metrics().frames();
   out.event = state.event.result();
+  out.frames = state.stack.detection_frames();
   out.slam_steps_beside = state.stack.slam_steps_beside();
   return out;
 }
@@ -184,6 +186,29 @@ TEST(Simulation, APerceptionLatencyDelaysEachFrameAndTheScansThreadChangesNothin
     EXPECT_EQ(one.slam_steps_beside, 0) << latency;
     EXPECT_GT(two.slam_steps_beside, 40) << latency;
   }
+}
+
+TEST(Simulation, AFrameWhoseOdometryIsLateIsMappedOnTheLoopsThreadAndTheRunStays) {
+  // the VCU's frames (the IMU's among them) all lost for 0.6 s, with a
+  // rotation's latency on two threads: the frames whose odometry has not
+  // come when they are due are mapped on the stack's thread, as on one
+  // thread (and no frame is stepped beside the loop while one waits), the
+  // others beside it: the same run, bit for bit
+  const ScenarioOnTrack& s = default_setup();
+  Scenario sc = s.scenario;
+  sc.perception.latency = 0.1;
+  sc.faults.can.at = 3.0;
+  sc.faults.can.duration = 0.6;
+  sc.faults.can.loss = 1.0;
+  const Trace one = drive(compile_model(sc, s.track));
+  sc.perception.threads = 2;
+  const Trace two = drive(compile_model(sc, s.track));
+  EXPECT_TRUE(same_rows(one.log, two.log));
+  EXPECT_EQ(one.frames, two.frames);
+  EXPECT_GT(two.frames, 20);
+  EXPECT_GT(two.slam_steps_beside, 10);
+  // some waited for their odometry
+  EXPECT_LT(two.slam_steps_beside, two.frames) << two.slam_steps_beside << " of " << two.frames;
 }
 
 TEST(Simulation, ADivergingCarEndsTheRunWithItsReasonNotACrash) {
