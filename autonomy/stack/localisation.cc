@@ -157,9 +157,7 @@ void Localisation::process(const hal::ConeDetections& d, const Pose2& odom) {
 
 void Localisation::step(const hal::ConeDetections& d, const Pose2& odom, SlamStep& out) {
   const auto t0 = std::chrono::steady_clock::now();
-  step_ = &out;
   out.map_news = false;
-  out.frames = 1;
   out.empty_frames = out.lost_frames = 0;
   out.loop_closures = out.graph_failures = out.relocalisations = out.relocalisation_failures = 0;
   out.optimise_ms.clear();
@@ -182,11 +180,11 @@ void Localisation::step(const hal::ConeDetections& d, const Pose2& odom, SlamSte
     lost_run_ = lost_in_frame() ? lost_run_ + 1 : 0;
     if (lost_run_ > 0) out.lost_frames = 1;
     // (slam = lio: the pose is the LIO's, the cones do not move it)
-    if (lost_run_ >= params_.relocalisation.lost_frames && mode_ != SlamMode::Lio) relocalise_on(obs);
+    if (lost_run_ >= params_.relocalisation.lost_frames && mode_ != SlamMode::Lio) relocalise_on(obs, out);
     if (graph() && lost_run_ == 0) {
       const bool closure = closes_loop();
       record_node(odom, closure);
-      if (closure) optimise_graph();
+      if (closure) optimise_graph(out);
     }
   }
   out.correction = compose(fastslam_->pose(), between(odom, Pose2{}));
@@ -207,7 +205,6 @@ void Localisation::step(const hal::ConeDetections& d, const Pose2& odom, SlamSte
       out.map.push_back(m);
     }
   }
-  step_ = nullptr;
   const auto t1 = std::chrono::steady_clock::now();
   out.update_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
 }
@@ -223,7 +220,7 @@ void Localisation::publish(SlamStep& s) {
     map_.swap(s.map);
     map_news_ = true;
   }
-  stats_.frames += s.frames;
+  ++stats_.frames;
   stats_.empty_frames += s.empty_frames;
   stats_.lost_frames += s.lost_frames;
   stats_.loop_closures += s.loop_closures;
@@ -262,9 +259,9 @@ bool Localisation::closes_loop() const {
   return matches >= lc.min_matches;
 }
 
-void Localisation::optimise_graph() {
+void Localisation::optimise_graph(SlamStep& out) {
   const auto t0 = std::chrono::steady_clock::now();
-  ++step_->loop_closures;
+  ++out.loop_closures;
   last_closure_at_ = driven_;
   closure_nodes_.push_back(static_cast<int>(nodes_.size()) - 1);
   // the window: from the closure window_laps back (the start until then)
@@ -290,8 +287,8 @@ void Localisation::optimise_graph() {
   const int held = params_.loop_closure.hold_optimised && optimised_until_ >= first ? optimised_until_ - first + 1 : 1;
   const slam::PoseGraph::Result r = graph.optimise(held);
   if (!r.ok) {
-    ++step_->graph_failures;
-    step_->last_fault = "pose graph: " + r.reason;
+    ++out.graph_failures;
+    out.last_fault = "pose graph: " + r.reason;
   } else {
     for (int i = first; i < static_cast<int>(nodes_.size()); ++i) nodes_[i].estimate = graph.pose(i - first);
     optimised_until_ = static_cast<int>(nodes_.size()) - 1;
@@ -303,7 +300,7 @@ void Localisation::optimise_graph() {
     fastslam_->reanchor(nodes_.back().estimate, map, std::numeric_limits<std::int64_t>::max(),
                         params_.fastslam.closed_particles);
   }
-  step_->optimise_ms.push_back(
+  out.optimise_ms.push_back(
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
 }
 
@@ -322,7 +319,7 @@ bool Localisation::lost_in_frame() const {
          static_cast<double>(associated) < rp.lost_ratio * static_cast<double>(seen.size());
 }
 
-void Localisation::relocalise_on(const std::vector<slam::Observation>& obs) {
+void Localisation::relocalise_on(const std::vector<slam::Observation>& obs, SlamStep& out) {
   // the map as it was before the car got lost: the landmarks the lost
   // frames started are where the lost pose put them (ghosts of the cones it
   // sees, which would fit the lost pose); tentative ones count (the far
@@ -336,12 +333,12 @@ void Localisation::relocalise_on(const std::vector<slam::Observation>& obs) {
   const std::optional<slam::Relocalisation> r =
       slam::relocalise(map, points, fastslam_->pose(), params_.relocalisation);
   if (!r) {
-    ++step_->relocalisation_failures;
-    step_->last_fault = "lost: no pose near the estimate fits the map";
+    ++out.relocalisation_failures;
+    out.last_fault = "lost: no pose near the estimate fits the map";
     return;
   }
-  ++step_->relocalisations;
-  step_->last_fault = "lost: relocalised";
+  ++out.relocalisations;
+  out.last_fault = "lost: relocalised";
   fastslam_->reanchor(r->pose, {}, lost_since);
   lost_run_ = 0;
   // the odometry's chain broke where the car was moved: the graph starts

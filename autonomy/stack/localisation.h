@@ -159,9 +159,10 @@ struct SlamStep {
   int lost_run = 0;
   bool map_news = false;
   std::vector<slam::MappedCone> map;  // SLAM's map after the frame, when map_news
-  // what the frame adds to the stats: its counts, the graph's solve, the
-  // update's wall time, its last fault (empty: none)
-  long frames = 0, empty_frames = 0, lost_frames = 0;
+  // what the frame adds to the stats (besides itself, one frame): its
+  // counts, the graph's solve, the update's wall time, its last fault
+  // (empty: none)
+  long empty_frames = 0, lost_frames = 0;
   int loop_closures = 0, graph_failures = 0, relocalisations = 0, relocalisation_failures = 0;
   std::vector<double> optimise_ms;
   double update_ms = 0.0;
@@ -253,10 +254,11 @@ class Localisation {
   // slam = fastslam_graph: the frame's node and sightings, and a closure's optimisation
   void record_node(const Pose2& odom, bool closure);
   bool closes_loop() const;
-  void optimise_graph();
+  // (a frame's step: its counts and faults go into out)
+  void optimise_graph(SlamStep& out);
   // the front end lost: relocalise on this frame
   bool lost_in_frame() const;
-  void relocalise_on(const std::vector<slam::Observation>& obs);
+  void relocalise_on(const std::vector<slam::Observation>& obs, SlamStep& out);
 
   SlamParams params_;
   SlamMode mode_;
@@ -277,7 +279,6 @@ class Localisation {
   LocalisationStats stats_;
   SlamStep process_step_;                    // process()'s
   // SLAM's own (step)
-  SlamStep* step_ = nullptr;                 // the step under way
   Pose2 last_frame_odom_;                    // the odometry at the last stepped frame
   // slam = fastslam_graph
   Pose2 start_;
